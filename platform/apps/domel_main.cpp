@@ -1,0 +1,263 @@
+// SPDX-License-Identifier: MIT
+// The domel executable: run, validate, plugins, schema, docs, version.
+// Command-line parsing is a few lines by hand: the sub-commands take at most
+// three options each, which does not justify another dependency.
+// Exit codes: 0 success, 1 the run failed, 2 the scenario (or a plugin) was
+// refused, 64 wrong command-line usage.
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "loader/plugin_registry.hpp"
+#include "scenario/reference.hpp"
+#include "scenario/scenario.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <optional>
+
+namespace dp = domel::platform;
+
+namespace {
+
+constexpr int kExitRunFailed = 1;
+constexpr int kExitRefused = 2;
+constexpr int kExitUsage = 64;
+
+const char* kUsage = R"(usage: domel <command> [options]
+
+commands:
+  run FILE [--out DIR] [--threads N] [--max-steps N] [--quiet] [--verbose]
+                      validate and run a scenario; writes particles_*.vtp + particles.pvd
+                      (ParaView), probes.csv and summary.json into the output folder
+  validate FILE...    check scenarios without running them; lists every problem
+  plugins [--json]    list loaded plugin models with versions, ABI and parameters
+  schema [--out FILE] print the complete scenario JSON Schema (for editors, via "$schema")
+  docs [--out FILE]   print the scenario reference (Markdown) generated from the schemas
+  version             print versions
+
+plugins are loaded from the built-in folder, then from each folder in
+$DOMEL_PLUGIN_PATH (':'-separated), then from the scenario's "plugins" list.
+)";
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Args {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> options;  // --key value
+  std::vector<std::string> flags;              // --flag
+  bool flag(const std::string& f) const { return std::find(flags.begin(), flags.end(), f) != flags.end(); }
+  std::optional<std::string> option(const std::string& o) const {
+    auto it = options.find(o);
+    return it == options.end() ? std::nullopt : std::optional<std::string>(it->second);
+  }
+};
+
+Args parse(int argc, char** argv, int first, const std::vector<std::string>& with_value,
+           const std::vector<std::string>& flags) {
+  Args a;
+  for (int k = first; k < argc; ++k) {
+    const std::string s = argv[k];
+    if (s.rfind("--", 0) == 0) {
+      if (std::find(with_value.begin(), with_value.end(), s) != with_value.end()) {
+        if (k + 1 >= argc) throw UsageError("option " + s + " needs a value");
+        a.options[s] = argv[++k];
+      } else if (std::find(flags.begin(), flags.end(), s) != flags.end()) {
+        a.flags.push_back(s);
+      } else {
+        std::vector<std::string> all = with_value;
+        all.insert(all.end(), flags.begin(), flags.end());
+        const std::string hint = dp::suggest(s, all);
+        throw UsageError("unknown option " + s + (hint.empty() ? "" : " (" + hint + ")"));
+      }
+    } else {
+      a.positional.push_back(s);
+    }
+  }
+  return a;
+}
+
+long parse_count(const std::string& option, const std::string& value) {
+  try {
+    std::size_t used = 0;
+    const long v = std::stol(value, &used);
+    if (used != value.size() || v < 1) throw std::invalid_argument("");
+    return v;
+  } catch (const std::exception&) {
+    throw UsageError(option + " expects a positive integer, found '" + value + "'");
+  }
+}
+
+void load_default_plugins(dp::PluginRegistry& registry) {
+  for (const auto& dir : dp::default_plugin_directories()) {
+    const std::size_t n = registry.load_directory(dir);
+    if (n) spdlog::debug("plugins: {} librar{} from {}", n, n == 1 ? "y" : "ies", dir.string());
+  }
+  for (const auto& r : registry.refused()) spdlog::warn("{}", r);
+}
+
+void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
+  std::fprintf(stderr, "domel: %s has %zu problem%s:\n", what.c_str(), diags.size(), diags.size() == 1 ? "" : "s");
+  for (const auto& d : diags) {
+    std::string line = "  - at " + (d.pointer.empty() ? std::string("/") : d.pointer) + ": " + d.message;
+    if (!d.hint.empty()) line += " (" + d.hint + ")";
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+}
+
+int cmd_run(int argc, char** argv) {
+  const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps"}, {"--quiet", "--verbose"});
+  if (a.positional.size() != 1) throw UsageError("run expects one scenario file");
+  if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
+  if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
+  dp::RunOptions opt;
+  if (auto o = a.option("--out")) opt.output_directory = *o;
+  if (auto t = a.option("--threads")) opt.threads = static_cast<int>(parse_count("--threads", *t));
+  if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
+  opt.progress = !a.flag("--quiet");
+
+  dp::PluginRegistry registry;
+  load_default_plugins(registry);
+  std::unique_ptr<dp::Simulation> sim;
+  try {
+    sim = dp::load_scenario(a.positional[0], registry);
+  } catch (const dp::ConfigError& e) {
+    print_diagnostics(a.positional[0], e.diagnostics());
+    std::fprintf(stderr, "nothing was run and nothing was written.\n");
+    return kExitRefused;
+  }
+  try {
+    const auto result = sim->run(opt, registry);
+    std::printf("%s: %llu steps, %.6g s simulated, %.3g s wall, %.3g particle-steps/s; output in %s\n",
+                sim->name.c_str(), static_cast<unsigned long long>(result.macro_steps), result.simulated_time,
+                result.wall_seconds, result.particle_steps_per_second, result.output_directory.string().c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "domel: the run of %s failed: %s\nFiles written before the failure are complete; "
+                         "summary.json was not written.\n", a.positional[0].c_str(), e.what());
+    return kExitRunFailed;
+  }
+  return 0;
+}
+
+int cmd_validate(int argc, char** argv) {
+  const Args a = parse(argc, argv, 2, {}, {});
+  if (a.positional.empty()) throw UsageError("validate expects at least one scenario file");
+  dp::PluginRegistry registry;
+  load_default_plugins(registry);
+  int rc = 0;
+  for (const auto& file : a.positional) {
+    const auto diags = dp::validate_scenario_file(file, registry);
+    if (diags.empty()) {
+      std::printf("%s: valid\n", file.c_str());
+    } else {
+      print_diagnostics(file, diags);
+      rc = kExitRefused;
+    }
+  }
+  return rc;
+}
+
+int cmd_plugins(int argc, char** argv) {
+  const Args a = parse(argc, argv, 2, {}, {"--json"});
+  dp::PluginRegistry registry;
+  load_default_plugins(registry);
+  if (a.flag("--json")) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& m : registry.models()) {
+      const auto& lib = registry.libraries()[m.library];
+      out.push_back({{"name", m.name}, {"kind", dp::kind_name(m.desc.kind)}, {"version", m.version},
+                     {"summary", m.summary}, {"history_slots", m.desc.history_slots},
+                     {"library", lib.name}, {"library_version", lib.version}, {"path", lib.path.string()},
+                     {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)},
+                     {"parameters", m.schema}});
+    }
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+  const nlohmann::json root = dp::composed_scenario_schema(registry);
+  for (const auto& lib : registry.libraries()) {
+    std::printf("library %s %s (ABI %u.%u) %s\n", lib.name.c_str(), lib.version.c_str(), lib.abi_major,
+                lib.abi_minor, lib.path.string().c_str());
+    for (const auto& m : registry.models()) {
+      if (&registry.libraries()[m.library] != &lib) continue;
+      std::printf("  %-10s %-14s %-7s %s\n", dp::kind_name(m.desc.kind), m.name.c_str(), m.version.c_str(),
+                  m.summary.c_str());
+      for (const auto& r : dp::parameter_rows(m.schema, root)) {
+        std::string detail = r.type;
+        if (!r.unit.empty()) detail += ", " + r.unit;
+        if (!r.constraint.empty()) detail += ", " + r.constraint;
+        if (r.required) detail += ", required";
+        if (!r.default_value.empty()) detail += ", default " + r.default_value;
+        std::printf("      %-18s %s — %s\n", r.name.c_str(), detail.c_str(), r.description.c_str());
+      }
+    }
+  }
+  if (registry.libraries().empty()) std::printf("no plugin libraries found\n");
+  return 0;
+}
+
+int write_or_print(const Args& a, const std::string& text) {
+  if (auto out = a.option("--out")) {
+    domel::platform::io::write_file_atomically(*out, text);
+  } else {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+  }
+  return 0;
+}
+
+int cmd_schema(int argc, char** argv) {
+  const Args a = parse(argc, argv, 2, {"--out"}, {});
+  dp::PluginRegistry registry;
+  load_default_plugins(registry);
+  return write_or_print(a, dp::composed_scenario_schema(registry).dump(2) + "\n");
+}
+
+int cmd_docs(int argc, char** argv) {
+  const Args a = parse(argc, argv, 2, {"--out"}, {});
+  dp::PluginRegistry registry;
+  load_default_plugins(registry);
+  return write_or_print(a, dp::scenario_reference_markdown(registry));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  auto logger = spdlog::stderr_color_mt("domel");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("%^[%l]%$ %v");
+  if (argc < 2) {
+    std::fputs(kUsage, stderr);
+    return kExitUsage;
+  }
+  const std::string cmd = argv[1];
+  try {
+    if (cmd == "run") return cmd_run(argc, argv);
+    if (cmd == "validate") return cmd_validate(argc, argv);
+    if (cmd == "plugins") return cmd_plugins(argc, argv);
+    if (cmd == "schema") return cmd_schema(argc, argv);
+    if (cmd == "docs") return cmd_docs(argc, argv);
+    if (cmd == "version" || cmd == "--version") {
+      std::printf("domel %s (SDK ABI %d.%d)\n", DOMEL_VERSION, DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR);
+      return 0;
+    }
+    if (cmd == "help" || cmd == "--help" || cmd == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    const std::string hint = dp::suggest(cmd, {"run", "validate", "plugins", "schema", "docs", "version", "help"});
+    throw UsageError("unknown command '" + cmd + "'" + (hint.empty() ? "" : " (" + hint + ")"));
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "domel: %s\n\n%s", e.what(), kUsage);
+    return kExitUsage;
+  } catch (const dp::ConfigError& e) {
+    print_diagnostics("the input", e.diagnostics());
+    return kExitRefused;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "domel: %s\n", e.what());
+    return kExitRunFailed;
+  }
+}

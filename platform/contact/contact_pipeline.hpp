@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: MIT
+// The contact model of a subdomain: slots filled at run time by plugin
+// instances and evaluated in a fixed order on batches of contacts
+// (normal -> damping -> F_n sum -> tangential -> rolling -> twisting),
+// as LAMMPS' granular sub-models are (style.md). Each slot owns a slice of
+// the per-contact history; the pipeline lays the slices out in one stride.
+//
+// Callers fill the input arrays of `batch()` for up to kBatchSize contacts
+// (and their history rows), call evaluate(n), then read fn and the
+// tangential force and torque outputs.
+#pragma once
+
+#include "loader/plugin_registry.hpp"
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace domel::platform {
+
+enum class Slot { normal = 0, damping, tangential, rolling, twisting };
+constexpr std::size_t kSlotCount = 5;
+constexpr const char* kSlotNames[kSlotCount] = {"normal", "damping", "tangential", "rolling", "twisting"};
+
+class ContactPipeline {
+ public:
+  static constexpr uint32_t kBatchSize = 256;
+
+  /// normal, damping and tangential are required; rolling and twisting may be null.
+  explicit ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots);
+
+  uint32_t history_stride() const { return history_stride_; }
+  const ModelInstance* slot(Slot s) const { return slots_[static_cast<int>(s)].get(); }
+
+  /// Buffers of one batch (structure of arrays, capacity kBatchSize).
+  struct Buffers {
+    std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, vn, vtx, vty, vtz, wx, wy, wz;
+    std::vector<double> fn_elastic, kn, kn_tangent, contact_radius, fn_damping, eta_n, fn;
+    std::vector<double> ftx, fty, ftz, tqx, tqy, tqz;
+    std::vector<double> history;  ///< kBatchSize * history_stride
+  };
+  Buffers& buffers() { return buf_; }
+  const Buffers& buffers() const { return buf_; }
+
+  /// Evaluate all stages on the first n contacts of the buffers.
+  void evaluate(const domel_pair_v1& pair, double dt, uint32_t n);
+
+ private:
+  std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots_;
+  std::array<uint32_t, kSlotCount> offset_{};
+  uint32_t history_stride_ = 0;
+  Buffers buf_;
+  domel_contact_batch_v1 batch_{};
+};
+
+}  // namespace domel::platform

@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: MIT
+// Materials and material pairs. A material carries the intrinsic constants;
+// the pair constants handed to contact kernels (E*, G*, e, mu) are derived
+// here with the Hertz–Mindlin effective-modulus rules (docs/physics.md §1.1).
+#pragma once
+
+#include <domel/sdk/abi.h>
+
+#include <string>
+
+namespace domel::platform {
+
+struct Material {
+  std::string name;
+  double density = 0.0;         ///< [kg/m^3]
+  double youngs_modulus = 0.0;  ///< [Pa]
+  double poisson_ratio = 0.0;   ///< [-]
+};
+
+/// Restitution and friction of one pair of materials.
+struct PairCoefficients {
+  double restitution = 0.0;
+  double friction = 0.0;
+};
+
+/// 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j ; 1/G* = 2(2-nu_i)(1+nu_i)/E_i + (same for j).
+inline domel_pair_v1 make_pair(const Material& a, const Material& b, const PairCoefficients& c,
+                               bool is_wall, double coarse_grain) {
+  domel_pair_v1 p{};
+  p.struct_size = sizeof(domel_pair_v1);
+  p.is_wall = is_wall ? 1u : 0u;
+  p.youngs_eff = 1.0 / ((1.0 - a.poisson_ratio * a.poisson_ratio) / a.youngs_modulus +
+                        (1.0 - b.poisson_ratio * b.poisson_ratio) / b.youngs_modulus);
+  p.shear_eff = 1.0 / (2.0 * (2.0 - a.poisson_ratio) * (1.0 + a.poisson_ratio) / a.youngs_modulus +
+                       2.0 * (2.0 - b.poisson_ratio) * (1.0 + b.poisson_ratio) / b.youngs_modulus);
+  p.restitution = c.restitution;
+  p.friction = c.friction;
+  p.coarse_grain = coarse_grain;
+  return p;
+}
+
+}  // namespace domel::platform

@@ -1,0 +1,168 @@
+// SPDX-License-Identifier: MIT
+// Cell-list construction of the Verlet list and history carry-over.
+#include "core/neighbor_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace domel::platform {
+
+namespace {
+inline std::uint64_t pair_key(std::uint64_t a, std::uint64_t b) {
+  // ids below 2^32 in practice; mix both halves so larger ids still hash well
+  return (a << 32) ^ b ^ (a >> 32);
+}
+}  // namespace
+
+bool NeighborList::needs_rebuild(const ParticleStore& s) const {
+  if (builds_ == 0 || s.size() != built_size_) return true;
+  const double limit2 = 0.25 * skin_ * skin_;
+  const std::size_t n = s.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const double dx = s.x[k] - x0_[k], dy = s.y[k] - y0_[k], dz = s.z[k] - z0_[k];
+    if (dx * dx + dy * dy + dz * dz > limit2) return true;
+  }
+  // the same slots must hold the same particles (re-ordering forces a rebuild)
+  for (std::size_t k = 0; k < n; ++k)
+    if (s.id[k] != built_ids_[k]) return true;
+  return false;
+}
+
+void NeighborList::build(const ParticleStore& s) {
+  const std::size_t n = s.size();
+  // Remember live history by (id_i, id_j).
+  std::unordered_map<std::uint64_t, std::size_t> old;
+  old.reserve(i.size());
+  for (std::size_t k = 0; k < i.size(); ++k)
+    if (touching[k]) old.emplace(pair_key(built_ids_[i[k]], built_ids_[j[k]]), k);
+  std::vector<double> old_history;
+  old_history.swap(history);
+  std::vector<uint32_t> old_i, old_j;
+  old_i.swap(i);
+  old_j.swap(j);
+  touching.clear();
+
+  if (n > 0) {
+    double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                    std::numeric_limits<double>::max()};
+    double hi[3] = {-lo[0], -lo[1], -lo[2]};
+    double rmax = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      lo[0] = std::min(lo[0], s.x[k]); hi[0] = std::max(hi[0], s.x[k]);
+      lo[1] = std::min(lo[1], s.y[k]); hi[1] = std::max(hi[1], s.y[k]);
+      lo[2] = std::min(lo[2], s.z[k]); hi[2] = std::max(hi[2], s.z[k]);
+      rmax = std::max(rmax, s.radius[k]);
+    }
+    const double cell = 2.0 * rmax + skin_;
+    int dim[3];
+    for (int a = 0; a < 3; ++a) {
+      const double span = hi[a] - lo[a];
+      dim[a] = std::max(1, std::min(1 << 20, static_cast<int>(span / cell) + 1));
+    }
+    // Keep the cell count bounded for sparse systems.
+    while (static_cast<double>(dim[0]) * dim[1] * dim[2] > 8.0 * static_cast<double>(n) + 64) {
+      for (int a = 0; a < 3; ++a) dim[a] = std::max(1, dim[a] / 2 + (dim[a] % 2));
+    }
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = dim[a] / std::max(hi[a] - lo[a], 1e-300) * (1.0 - 1e-12);
+    auto cell_of = [&](std::size_t k, int* c) {
+      const double p[3] = {s.x[k], s.y[k], s.z[k]};
+      for (int a = 0; a < 3; ++a) c[a] = std::min(dim[a] - 1, std::max(0, static_cast<int>((p[a] - lo[a]) * inv[a])));
+    };
+    const std::size_t ncell = static_cast<std::size_t>(dim[0]) * dim[1] * dim[2];
+    std::vector<uint32_t> start(ncell + 1, 0), order(n), cell_index(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      int c[3];
+      cell_of(k, c);
+      cell_index[k] = static_cast<uint32_t>((static_cast<std::size_t>(c[2]) * dim[1] + c[1]) * dim[0] + c[0]);
+      ++start[cell_index[k] + 1];
+    }
+    for (std::size_t c = 0; c < ncell; ++c) start[c + 1] += start[c];
+    {
+      std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+      for (std::size_t k = 0; k < n; ++k) order[fill[cell_index[k]]++] = static_cast<uint32_t>(k);
+    }
+    i.reserve(old_i.size() + n);
+    j.reserve(old_j.size() + n);
+    for (std::size_t a = 0; a < n; ++a) {
+      int c[3];
+      cell_of(a, c);
+      for (int dz = -1; dz <= 1; ++dz) {
+        const int cz = c[2] + dz;
+        if (cz < 0 || cz >= dim[2]) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
+          const int cy = c[1] + dy;
+          if (cy < 0 || cy >= dim[1]) continue;
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int cx = c[0] + dx;
+            if (cx < 0 || cx >= dim[0]) continue;
+            const std::size_t cc = (static_cast<std::size_t>(cz) * dim[1] + cy) * dim[0] + cx;
+            for (uint32_t q = start[cc]; q < start[cc + 1]; ++q) {
+              const uint32_t b = order[q];
+              if (b <= a) continue;
+              const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
+              const double cut = s.radius[a] + s.radius[b] + skin_;
+              if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) {
+                if (s.id[a] < s.id[b]) { i.push_back(static_cast<uint32_t>(a)); j.push_back(b); }
+                else { i.push_back(b); j.push_back(static_cast<uint32_t>(a)); }
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  history.assign(i.size() * stride_, 0.0);
+  touching.assign(i.size(), 0);
+  if (!old.empty() && stride_ > 0) {
+    for (std::size_t k = 0; k < i.size(); ++k) {
+      auto it = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
+      if (it == old.end()) continue;
+      std::copy_n(old_history.begin() + it->second * stride_, stride_, history.begin() + k * stride_);
+      touching[k] = 1;
+    }
+  }
+  x0_ = s.x; y0_ = s.y; z0_ = s.z;
+  built_ids_ = s.id;
+  built_size_ = n;
+  ++builds_;
+}
+
+void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride) {
+  std::unordered_map<std::uint64_t, std::size_t> old;
+  std::vector<double> old_history;
+  old_history.swap(history);
+  for (std::size_t k = 0; k < particle.size(); ++k)
+    if (touching[k]) old.emplace(particle_id[k], k);
+  particle.clear();
+  particle_id.clear();
+  touching.clear();
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    double d, nx, ny, nz;
+    if (!w.gap(s.x[k], s.y[k], s.z[k], d, nx, ny, nz)) {
+      // outside a mantle's extent now, but may enter within the skin
+      if (w.shape == WallPrimitive::Shape::cylinder_inside) {
+        const double along = (w.axis == 0 ? s.x[k] : w.axis == 1 ? s.y[k] : s.z[k]);
+        if (along < w.lo - s.radius[k] - skin || along > w.hi + s.radius[k] + skin) continue;
+        particle.push_back(static_cast<uint32_t>(k));
+      }
+      continue;
+    }
+    if (d < s.radius[k] + skin) particle.push_back(static_cast<uint32_t>(k));
+  }
+  for (const uint32_t k : particle) particle_id.push_back(s.id[k]);
+  history.assign(particle.size() * stride, 0.0);
+  touching.assign(particle.size(), 0);
+  if (!old.empty() && stride > 0) {
+    for (std::size_t k = 0; k < particle.size(); ++k) {
+      auto it = old.find(particle_id[k]);
+      if (it == old.end()) continue;
+      std::copy_n(old_history.begin() + it->second * stride, stride, history.begin() + k * stride);
+      touching[k] = 1;
+    }
+  }
+}
+
+}  // namespace domel::platform

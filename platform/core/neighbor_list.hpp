@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// Verlet neighbour list built from a cell list, with a skin, plus the
+// per-pair contact history. The list is a half list: each pair once, oriented
+// so that id[i] < id[j]; that orientation never changes, so a history vector
+// (defined for "i relative to j") keeps its meaning across rebuilds and
+// re-ordering. On rebuild the history of every pair still in contact is
+// carried over by the pair's ids. Rebuild when any particle moved more than
+// half the skin since the last build (then no pair can have entered contact
+// unseen).
+#pragma once
+
+#include "core/particle_store.hpp"
+#include "geometry/wall.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace domel::platform {
+
+class NeighborList {
+ public:
+  void configure(double skin, uint32_t history_stride) {
+    skin_ = skin;
+    stride_ = history_stride;
+  }
+  double skin() const { return skin_; }
+  uint32_t stride() const { return stride_; }
+
+  bool needs_rebuild(const ParticleStore& s) const;
+  void build(const ParticleStore& s);
+  std::size_t size() const { return i.size(); }
+  std::size_t builds() const { return builds_; }
+
+  std::vector<uint32_t> i, j;      ///< particle indices, id[i] < id[j]
+  std::vector<double> history;     ///< size() * stride
+  std::vector<uint8_t> touching;   ///< 1 while the pair is in contact (history live)
+
+ private:
+  double skin_ = 0.0;
+  uint32_t stride_ = 0;
+  std::size_t builds_ = 0;
+  std::vector<double> x0_, y0_, z0_;
+  std::vector<std::uint64_t> built_ids_;
+  std::size_t built_size_ = 0;
+  friend class WallNeighbors;
+};
+
+/// Candidate particles of one wall primitive, with per-contact history.
+class WallNeighbors {
+ public:
+  void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride);
+  std::vector<uint32_t> particle;      ///< particle indices at this build
+  std::vector<std::uint64_t> particle_id;  ///< their ids (history is carried over by id)
+  std::vector<double> history;
+  std::vector<uint8_t> touching;
+};
+
+}  // namespace domel::platform

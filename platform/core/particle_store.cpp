@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: MIT
+// Particle store mutations: append, swap-remove and permutation.
+#include "core/particle_store.hpp"
+
+#include <cmath>
+
+namespace domel::platform {
+
+void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, double r,
+                        double density) {
+  const double m = density * 4.0 / 3.0 * M_PI * r * r * r;
+  const double inertia = 0.4 * m * r * r;  // solid sphere
+  id.push_back(pid);
+  x.push_back(px); y.push_back(py); z.push_back(pz);
+  for (auto* v : {&vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz}) v->push_back(0.0);
+  radius.push_back(r);
+  mass.push_back(m);
+  inv_mass.push_back(1.0 / m);
+  inv_inertia.push_back(1.0 / inertia);
+  contacts.push_back(0);
+}
+
+void ParticleStore::swap_remove(std::size_t k) {
+  for_each_array([k](auto& v) {
+    v[k] = v.back();
+    v.pop_back();
+  });
+}
+
+void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
+  for_each_array([&order](auto& v) {
+    auto tmp = v;
+    for (std::size_t k = 0; k < order.size(); ++k) v[k] = tmp[order[k]];
+  });
+}
+
+}  // namespace domel::platform

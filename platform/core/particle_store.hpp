@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: MIT
+// The particle store of one subdomain: structure of arrays, one std::vector
+// per scalar component, no per-particle objects. Everything that moves with a
+// particle when the store is re-ordered is listed in for_each_array().
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace domel::platform {
+
+struct ParticleStore {
+  std::vector<std::uint64_t> id;           ///< unique within the run, stable
+  std::vector<double> x, y, z;             ///< position [m]
+  std::vector<double> vx, vy, vz;          ///< velocity [m/s]
+  std::vector<double> wx, wy, wz;          ///< angular velocity [rad/s]
+  std::vector<double> fx, fy, fz;          ///< force [N] (rebuilt every step)
+  std::vector<double> tx, ty, tz;          ///< torque [N m] (rebuilt every step)
+  std::vector<double> radius;              ///< [m] (parcel radius, alpha already applied)
+  std::vector<double> mass;                ///< [kg]
+  std::vector<double> inv_mass;            ///< 1/mass [1/kg]
+  std::vector<double> inv_inertia;         ///< 1/I, I = 2/5 m r^2 for a solid sphere [1/(kg m^2)]
+  std::vector<std::uint32_t> contacts;     ///< contact count in the last force evaluation
+
+  std::size_t size() const { return id.size(); }
+
+  /// Append one particle at rest. Mass from density and radius.
+  void add(std::uint64_t pid, double px, double py, double pz, double r, double density);
+
+  /// Remove particle k by moving the last one into its place.
+  void swap_remove(std::size_t k);
+
+  /// Apply a permutation: new index k holds old particle order[k].
+  void permute(const std::vector<std::uint32_t>& order);
+
+  /// Visit every per-particle array (for permutation, removal, resizing).
+  template <class F>
+  void for_each_array(F&& f) {
+    f(id); f(x); f(y); f(z); f(vx); f(vy); f(vz); f(wx); f(wy); f(wz);
+    f(fx); f(fy); f(fz); f(tx); f(ty); f(tz);
+    f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts);
+  }
+};
+
+}  // namespace domel::platform

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// A CSV time series (energies, forces on walls, timings ...) that a plotting
+// script can read at any moment during a run: the whole text is kept in
+// memory and the file is rewritten atomically on flush, so a reader never
+// sees a half-written row. Numbers are written in the shortest form that reads
+// back to the identical double (std::to_chars), so nothing is lost and rows
+// stay short.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace domel::platform::io {
+
+/// A CSV time series (header line + one row per append) that appears whole:
+/// rows are buffered and the whole file is rewritten atomically by flush(),
+/// which append() calls automatically when at least `flush_every` rows are
+/// pending; the destructor flushes and never throws (a failure there is
+/// swallowed silently). The parent directory of `path` must exist when the
+/// file is first flushed. Column names containing ',', '"' or a line break are
+/// quoted as in RFC 4180.
+class CsvSeries {
+ public:
+  /// Throws std::invalid_argument if `columns` is empty. Touches no file.
+  CsvSeries(std::filesystem::path path, std::vector<std::string> columns,
+            std::size_t flush_every = 50);
+
+  CsvSeries(const CsvSeries&) = delete;
+  CsvSeries& operator=(const CsvSeries&) = delete;
+  /// The moved-from series no longer writes anything.
+  CsvSeries(CsvSeries&& other) noexcept;
+  CsvSeries& operator=(CsvSeries&&) = delete;
+
+  /// Throws std::invalid_argument if row.size() != columns.size(); the row
+  /// is not recorded then. May throw RuntimeError from an automatic flush.
+  void append(const std::vector<double>& row);
+
+  /// Rewrite the whole file (header and every row so far) atomically, even
+  /// when no row is pending. Throws RuntimeError if it cannot be written; the
+  /// rows stay in memory and the next flush tries again.
+  void flush();
+
+  /// Flushes if anything was never written (including a header-only file
+  /// when no row was ever appended); never throws.
+  ~CsvSeries();
+
+ private:
+  std::filesystem::path path_;
+  std::size_t columns_;
+  std::size_t flush_every_;
+  std::string text_;          ///< header + all rows, exactly the file contents
+  std::size_t pending_ = 0;   ///< rows appended since the last successful flush
+  bool dirty_ = true;         ///< file missing or out of date
+};
+
+}  // namespace domel::platform::io

@@ -1,0 +1,639 @@
+// SPDX-License-Identifier: MIT
+// Scenario validation passes and the construction of a Simulation.
+#include "scenario/scenario.hpp"
+
+#include "scenario/json_schema.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace domel::platform {
+
+extern const char* const kScenarioSchemaText;
+
+namespace {
+
+using nlohmann::json;
+
+constexpr uint32_t kSlotKinds[kSlotCount] = {DOMEL_KIND_NORMAL, DOMEL_KIND_DAMPING, DOMEL_KIND_TANGENTIAL,
+                                             DOMEL_KIND_ROLLING, DOMEL_KIND_TWISTING};
+constexpr const char* kDefaultSlotModel[kSlotCount] = {"hertz", "restitution", "mindlin", "none", "none"};
+
+std::string idx(const std::string& base, std::size_t k) { return base + "/" + std::to_string(k); }
+
+std::string escape_pointer_token(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    if (ch == '~') out += "~0";
+    else if (ch == '/') out += "~1";
+    else out += ch;
+  }
+  return out;
+}
+
+std::string fmt_num(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+/// Validation state shared by the passes.
+struct Checker {
+  std::filesystem::path file;
+  std::vector<Diagnostic> diags;
+  void add(const std::string& pointer, const std::string& message, const std::string& hint = {}) {
+    diags.push_back({file.string(), pointer, message, hint});
+  }
+};
+
+const json* member(const json& j, const char* key) {
+  if (!j.is_object()) return nullptr;
+  auto it = j.find(key);
+  return it == j.end() ? nullptr : &*it;
+}
+
+bool is_vec3(const json* j) {
+  return j && j->is_array() && j->size() == 3 && (*j)[0].is_number() && (*j)[1].is_number() && (*j)[2].is_number();
+}
+
+int axis_index(const json* j) {
+  if (!j || !j->is_string()) return 2;
+  const std::string a = j->get<std::string>();
+  return a == "x" ? 0 : a == "y" ? 1 : 2;
+}
+
+/// Platform keys of a model block that are not the plugin's parameters.
+std::vector<std::string> platform_keys(uint32_t kind) {
+  if (kind == DOMEL_KIND_INSERTION) return {"model", "region", "seed", "velocity"};
+  return {"model"};
+}
+
+json plugin_params(const json& block, uint32_t kind) {
+  json p = block;
+  for (const auto& k : platform_keys(kind)) p.erase(k);
+  return p;
+}
+
+json platform_block_properties(uint32_t kind) {
+  const json& defs = platform_scenario_schema()["$defs"];
+  if (kind == DOMEL_KIND_INSERTION) return defs["insertion_model"]["properties"];
+  return json::object();
+}
+
+}  // namespace
+
+const json& platform_scenario_schema() {
+  static const json schema = json::parse(kScenarioSchemaText);
+  return schema;
+}
+
+json model_block_schema(const RegisteredModel& model) {
+  json s = model.schema.is_object() ? model.schema : json::object();
+  if (!s.contains("type")) s["type"] = "object";
+  json props = s.contains("properties") && s["properties"].is_object() ? s["properties"] : json::object();
+  const json platform_props = platform_block_properties(model.desc.kind);
+  for (auto& [k, v] : platform_props.items()) props[k] = v;
+  props["model"] = json{{"const", model.name}, {"description", model.summary}};
+  s["properties"] = props;
+  json req = s.contains("required") && s["required"].is_array() ? s["required"] : json::array();
+  auto add_req = [&](const char* k) {
+    if (std::find(req.begin(), req.end(), json(k)) == req.end()) req.push_back(k);
+  };
+  add_req("model");
+  if (model.desc.kind == DOMEL_KIND_INSERTION) add_req("region");
+  s["required"] = req;
+  s.erase("$schema");
+  return s;
+}
+
+json composed_scenario_schema(const PluginRegistry& registry) {
+  json schema = platform_scenario_schema();
+  auto fill = [&](const char* def, uint32_t kind, bool allow_none) {
+    json alternatives = json::array();
+    for (const auto& m : registry.models())
+      if (m.desc.kind == kind) alternatives.push_back(model_block_schema(m));
+    if (allow_none)
+      alternatives.push_back(json{{"type", "object"},
+                                  {"properties", {{"model", {{"const", "none"}, {"description", "empty slot"}}}}},
+                                  {"required", {"model"}},
+                                  {"additionalProperties", false}});
+    if (alternatives.empty()) return;
+    schema["$defs"][def] = json{{"oneOf", alternatives}};
+  };
+  fill("normal_model", DOMEL_KIND_NORMAL, false);
+  fill("damping_model", DOMEL_KIND_DAMPING, false);
+  fill("tangential_model", DOMEL_KIND_TANGENTIAL, false);
+  fill("rolling_model", DOMEL_KIND_ROLLING, true);
+  fill("twisting_model", DOMEL_KIND_TWISTING, true);
+  fill("insertion_model", DOMEL_KIND_INSERTION, false);
+  return schema;
+}
+
+namespace {
+
+/// Validate one model block (contact slot or inserter). Returns the model or null.
+const RegisteredModel* check_model_block(Checker& ck, const PluginRegistry& registry, const json& block,
+                                         const std::string& pointer, uint32_t kind, bool allow_none) {
+  if (!block.is_object()) return nullptr;  // the platform schema already said so
+  const json* name = member(block, "model");
+  if (!name || !name->is_string()) return nullptr;
+  const std::string model = name->get<std::string>();
+  if (allow_none && model == "none") {
+    if (block.size() > 1) ck.add(pointer, "an empty slot (\"none\") takes no parameters");
+    return nullptr;
+  }
+  const RegisteredModel* m = registry.find(kind, model);
+  if (!m) {
+    auto names = registry.names(kind);
+    if (allow_none) names.push_back("none");
+    ck.add(pointer + "/model", std::string("unknown ") + kind_name(kind) + " model '" + model + "'",
+           names.empty() ? std::string("no ") + kind_name(kind) + " models are loaded" : suggest(model, names));
+    return nullptr;
+  }
+  json schema = model_block_schema(*m);
+  schema["$defs"] = platform_scenario_schema()["$defs"];
+  try {
+    SchemaValidator(schema).validate(block, ck.diags, pointer);
+  } catch (const std::exception& e) {
+    ck.add(pointer, std::string(kind_name(kind)) + " model '" + model + "' has a parameter schema domel cannot use: " + e.what());
+  }
+  for (auto& d : ck.diags)
+    if (d.file.empty()) d.file = ck.file.string();
+  return m;
+}
+
+void check_models(Checker& ck, const json& doc, const PluginRegistry& registry) {
+  const json* sds = member(doc, "subdomains");
+  if (!sds || !sds->is_array()) return;
+  for (std::size_t k = 0; k < sds->size(); ++k) {
+    const json& sd = (*sds)[k];
+    const std::string base = idx("/subdomains", k);
+    if (const json* contact = member(sd, "contact"); contact && contact->is_object()) {
+      for (std::size_t s = 0; s < kSlotCount; ++s) {
+        const json* block = member(*contact, kSlotNames[s]);
+        if (!block) continue;
+        const bool optional = s >= static_cast<std::size_t>(Slot::rolling);
+        if (!optional && block->is_object() && member(*block, "model") && (*block)["model"] == "none")
+          ck.add(base + "/contact/" + kSlotNames[s] + "/model",
+                 std::string("the ") + kSlotNames[s] + " slot cannot be empty",
+                 suggest("none", registry.names(kSlotKinds[s])));
+        else
+          check_model_block(ck, registry, *block, base + "/contact/" + kSlotNames[s], kSlotKinds[s], optional);
+      }
+    }
+    if (const json* ins = member(sd, "insert"); ins && ins->is_array())
+      for (std::size_t q = 0; q < ins->size(); ++q)
+        check_model_block(ck, registry, (*ins)[q], idx(base + "/insert", q), DOMEL_KIND_INSERTION, false);
+  }
+}
+
+void check_references(Checker& ck, const json& doc) {
+  std::vector<std::string> materials;
+  std::map<std::string, bool> has_density;
+  if (const json* mats = member(doc, "materials"); mats && mats->is_object()) {
+    for (auto& [name, m] : mats->items()) {
+      materials.push_back(name);
+      has_density[name] = m.is_object() && m.contains("density");
+    }
+    if (mats->empty()) ck.add("/materials", "expected at least one material, found none");
+  }
+  auto check_material = [&](const json* j, const std::string& pointer) -> std::string {
+    if (!j || !j->is_string()) return {};
+    const std::string name = j->get<std::string>();
+    if (std::find(materials.begin(), materials.end(), name) == materials.end()) {
+      ck.add(pointer, "unknown material '" + name + "'", suggest(name, materials));
+      return {};
+    }
+    return name;
+  };
+
+  // walls
+  std::vector<std::pair<std::string, std::string>> wall_materials;  // (wall name, material)
+  std::set<std::string> wall_names;
+  if (const json* walls = member(doc, "walls"); walls && walls->is_array()) {
+    static const std::map<std::string, std::set<std::string>> kAllowed = {
+        {"plane", {"name", "type", "material", "point", "normal"}},
+        {"box", {"name", "type", "material", "min", "max", "open"}},
+        {"cylinder", {"name", "type", "material", "axis", "center", "radius", "bottom", "top", "closed_bottom", "closed_top"}}};
+    static const std::map<std::string, std::vector<std::string>> kRequired = {
+        {"plane", {"point", "normal"}}, {"box", {"min", "max"}}, {"cylinder", {"center", "radius", "bottom", "top"}}};
+    for (std::size_t k = 0; k < walls->size(); ++k) {
+      const json& w = (*walls)[k];
+      const std::string base = idx("/walls", k);
+      if (!w.is_object()) continue;
+      const json* name = member(w, "name");
+      const json* type = member(w, "type");
+      if (name && name->is_string() && !wall_names.insert(name->get<std::string>()).second)
+        ck.add(base + "/name", "duplicate wall name '" + name->get<std::string>() + "'");
+      const std::string mat = check_material(member(w, "material"), base + "/material");
+      if (!mat.empty() && name && name->is_string()) wall_materials.emplace_back(name->get<std::string>(), mat);
+      if (!type || !type->is_string() || !kAllowed.count(type->get<std::string>())) continue;
+      const std::string t = type->get<std::string>();
+      for (auto& [key, v] : w.items())
+        if (!kAllowed.at(t).count(key) && key != "$comment")
+          ck.add(base + "/" + escape_pointer_token(key), "'" + key + "' does not apply to a " + t + " wall",
+                 "a " + t + " wall takes: " + [&] {
+                   std::string s;
+                   for (const auto& a : kAllowed.at(t)) s += (s.empty() ? "" : ", ") + a;
+                   return s;
+                 }());
+      for (const auto& req : kRequired.at(t))
+        if (!w.contains(req)) ck.add(base, "missing required property '" + req + "' of a " + t + " wall");
+      if (t == "plane" && is_vec3(member(w, "normal"))) {
+        const json& n = w["normal"];
+        const double len = std::sqrt(n[0].get<double>() * n[0].get<double>() + n[1].get<double>() * n[1].get<double>() +
+                                     n[2].get<double>() * n[2].get<double>());
+        if (len <= 0) ck.add(base + "/normal", "expected a non-zero normal vector, found [0, 0, 0]");
+      }
+      if (t == "box" && is_vec3(member(w, "min")) && is_vec3(member(w, "max")))
+        for (int a = 0; a < 3; ++a)
+          if (w["min"][a].get<double>() >= w["max"][a].get<double>())
+            ck.add(base + "/max/" + std::to_string(a),
+                   "expected max > min along " + std::string(1, "xyz"[a]) + ", found max " +
+                       fmt_num(w["max"][a].get<double>()) + " <= min " + fmt_num(w["min"][a].get<double>()));
+      if (t == "cylinder") {
+        const json* lo = member(w, "bottom");
+        const json* hi = member(w, "top");
+        if (lo && hi && lo->is_number() && hi->is_number() && lo->get<double>() >= hi->get<double>())
+          ck.add(base + "/top", "expected top > bottom, found top " + fmt_num(hi->get<double>()) + " <= bottom " +
+                                    fmt_num(lo->get<double>()));
+      }
+    }
+  }
+
+  // subdomains
+  std::set<std::string> sd_names;
+  std::vector<std::pair<std::string, std::string>> sd_materials;  // (subdomain, material)
+  if (const json* sds = member(doc, "subdomains"); sds && sds->is_array()) {
+    for (std::size_t k = 0; k < sds->size(); ++k) {
+      const json& sd = (*sds)[k];
+      const std::string base = idx("/subdomains", k);
+      const json* name = member(sd, "name");
+      if (name && name->is_string() && !sd_names.insert(name->get<std::string>()).second)
+        ck.add(base + "/name", "duplicate subdomain name '" + name->get<std::string>() + "'");
+      const std::string mat = check_material(member(sd, "material"), base + "/material");
+      if (!mat.empty()) {
+        if (!has_density[mat])
+          ck.add("/materials/" + escape_pointer_token(mat), "missing required property 'density'",
+                 "subdomain '" + (name && name->is_string() ? name->get<std::string>() : std::to_string(k)) +
+                     "' makes particles of this material");
+        sd_materials.emplace_back(name && name->is_string() ? name->get<std::string>() : std::to_string(k), mat);
+      }
+    }
+  }
+
+  // interactions
+  std::set<std::pair<std::string, std::string>> pairs;
+  if (const json* inter = member(doc, "interactions"); inter && inter->is_array()) {
+    for (std::size_t k = 0; k < inter->size(); ++k) {
+      const json* ms = member((*inter)[k], "materials");
+      if (!ms || !ms->is_array() || ms->size() != 2) continue;
+      const std::string a = check_material(&(*ms)[0], idx("/interactions", k) + "/materials/0");
+      const std::string b = check_material(&(*ms)[1], idx("/interactions", k) + "/materials/1");
+      if (a.empty() || b.empty()) continue;
+      if (!pairs.insert(std::minmax(a, b)).second)
+        ck.add(idx("/interactions", k), "duplicate interaction for materials '" + a + "' and '" + b + "'");
+    }
+  }
+  auto need = [&](const std::string& a, const std::string& b, const std::string& why) {
+    if (pairs.count(std::minmax(a, b))) return;
+    ck.add("/interactions", "no interaction for materials '" + a + "' and '" + b + "', needed by " + why,
+           "add {\"materials\": [\"" + a + "\", \"" + b + "\"], \"restitution\": ..., \"friction\": ...}");
+    pairs.insert(std::minmax(a, b));  // report each missing pair once
+  };
+  for (const auto& [sd, mat] : sd_materials) {
+    need(mat, mat, "subdomain '" + sd + "'");
+    for (const auto& [wall, wmat] : wall_materials) need(mat, wmat, "subdomain '" + sd + "' touching wall '" + wall + "'");
+  }
+}
+
+std::vector<Diagnostic> validate_document(const json& doc, const std::filesystem::path& file, PluginRegistry& registry) {
+  Checker ck;
+  ck.file = file;
+  // Plugin libraries named by the scenario, relative to its folder.
+  if (const json* plugins = member(doc, "plugins"); plugins && plugins->is_array()) {
+    for (std::size_t k = 0; k < plugins->size(); ++k) {
+      if (!(*plugins)[k].is_string()) continue;
+      std::filesystem::path p = (*plugins)[k].get<std::string>();
+      if (p.is_relative()) p = file.parent_path() / p;
+      try {
+        registry.load(p);
+      } catch (const PluginError& e) {
+        ck.add(idx("/plugins", k), e.what());
+      }
+    }
+  }
+  SchemaValidator(platform_scenario_schema()).validate(doc, ck.diags);
+  for (auto& d : ck.diags)
+    if (d.file.empty()) d.file = file.string();
+  check_models(ck, doc, registry);
+  check_references(ck, doc);
+  return ck.diags;
+}
+
+json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& diags) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    diags.push_back({file.string(), "", "cannot open the scenario file", "check the path"});
+    return {};
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  try {
+    return json::parse(ss.str());
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    const auto pos = what.find("] ");
+    if (pos != std::string::npos) what = what.substr(pos + 2);
+    diags.push_back({file.string(), "", "not valid JSON: " + what, ""});
+    return {};
+  }
+}
+
+domel_region_v1 make_region(const json& region) {
+  domel_region_v1 r{};
+  r.struct_size = sizeof(domel_region_v1);
+  if (region.contains("box")) {
+    r.shape = 1;
+    for (int a = 0; a < 3; ++a) {
+      r.lo[a] = region["box"]["min"][a].get<double>();
+      r.hi[a] = region["box"]["max"][a].get<double>();
+      r.center[a] = 0.5 * (r.lo[a] + r.hi[a]);
+    }
+  } else {
+    const json& c = region["cylinder"];
+    r.shape = 2;
+    r.axis = static_cast<uint32_t>(axis_index(member(c, "axis")));
+    r.radius = c["radius"].get<double>();
+    for (int a = 0; a < 3; ++a) {
+      r.center[a] = c["center"][a].get<double>();
+      r.lo[a] = r.center[a] - r.radius;
+      r.hi[a] = r.center[a] + r.radius;
+    }
+    r.lo[r.axis] = c["bottom"].get<double>();
+    r.hi[r.axis] = c["top"].get<double>();
+  }
+  return r;
+}
+
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material) {
+  std::vector<WallPrimitive> out;
+  const std::string name = w["name"].get<std::string>();
+  const std::string type = w["type"].get<std::string>();
+  auto plane = [&](const std::string& n, const double p[3], const double nrm[3]) {
+    WallPrimitive prim;
+    prim.shape = WallPrimitive::Shape::plane;
+    prim.name = n;
+    prim.material = material;
+    const double len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    for (int a = 0; a < 3; ++a) { prim.p[a] = p[a]; prim.n[a] = nrm[a] / len; }
+    out.push_back(prim);
+  };
+  if (type == "plane") {
+    const double p[3] = {w["point"][0].get<double>(), w["point"][1].get<double>(), w["point"][2].get<double>()};
+    const double n[3] = {w["normal"][0].get<double>(), w["normal"][1].get<double>(), w["normal"][2].get<double>()};
+    plane(name, p, n);
+  } else if (type == "box") {
+    std::set<std::string> open;
+    if (w.contains("open"))
+      for (const auto& f : w["open"]) open.insert(f.get<std::string>());
+    const char* faces[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+    for (int f = 0; f < 6; ++f) {
+      if (open.count(faces[f])) continue;
+      const int a = f / 2;
+      const bool is_min = f % 2 == 0;
+      double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+      p[a] = (is_min ? w["min"] : w["max"])[a].get<double>();
+      n[a] = is_min ? 1.0 : -1.0;
+      plane(name + "." + faces[f], p, n);
+    }
+  } else {
+    WallPrimitive m;
+    m.shape = WallPrimitive::Shape::cylinder_inside;
+    m.name = name + ".mantle";
+    m.material = material;
+    m.axis = axis_index(member(w, "axis"));
+    for (int a = 0; a < 3; ++a) m.c[a] = w["center"][a].get<double>();
+    m.radius = w["radius"].get<double>();
+    m.lo = w["bottom"].get<double>();
+    m.hi = w["top"].get<double>();
+    out.push_back(m);
+    double p[3] = {m.c[0], m.c[1], m.c[2]}, n[3] = {0, 0, 0};
+    if (w.value("closed_bottom", true)) {
+      p[m.axis] = m.lo; n[m.axis] = 1.0;
+      plane(name + ".bottom", p, n);
+    }
+    if (w.value("closed_top", false)) {
+      p[m.axis] = m.hi; n[m.axis] = -1.0;
+      plane(name + ".top", p, n);
+    }
+  }
+  return out;
+}
+
+std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& file, PluginRegistry& registry) {
+  Checker ck;
+  ck.file = file;
+  auto sim = std::make_unique<Simulation>();
+  sim->scenario_file = file;
+  sim->name = doc.value("name", file.stem().string());
+  if (doc.contains("gravity"))
+    for (int a = 0; a < 3; ++a) sim->gravity[a] = doc["gravity"][a].get<double>();
+
+  std::map<std::string, std::size_t> mat_index;
+  for (auto& [name, m] : doc["materials"].items()) {
+    Material mat;
+    mat.name = name;
+    mat.density = m.value("density", 0.0);
+    mat.youngs_modulus = m["youngs_modulus"].get<double>();
+    mat.poisson_ratio = m["poisson_ratio"].get<double>();
+    mat_index[name] = sim->materials.size();
+    sim->materials.push_back(mat);
+  }
+  std::map<std::pair<std::string, std::string>, PairCoefficients> coeffs;
+  for (const auto& it : doc["interactions"]) {
+    const auto key = std::minmax(it["materials"][0].get<std::string>(), it["materials"][1].get<std::string>());
+    coeffs[key] = {it["restitution"].get<double>(), it["friction"].get<double>()};
+  }
+  if (doc.contains("walls"))
+    for (const auto& w : doc["walls"]) {
+      auto prims = expand_wall(w, mat_index.at(w["material"].get<std::string>()));
+      sim->walls.insert(sim->walls.end(), prims.begin(), prims.end());
+    }
+
+  const json& run = doc["run"];
+  sim->seed = run.value("seed", static_cast<std::uint64_t>(1));
+  sim->threads = run.value("threads", 1);
+
+  std::uint64_t next_id = 1;
+  const json& sds = doc["subdomains"];
+  for (std::size_t k = 0; k < sds.size(); ++k) {
+    const json& sd = sds[k];
+    const std::string base = idx("/subdomains", k);
+    const std::string sd_name = sd["name"].get<std::string>();
+    const std::string mat_name = sd["material"].get<std::string>();
+    const double alpha = sd.value("coarse_grain", 1.0);
+    const json contact = sd.value("contact", json::object());
+
+    std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots;
+    json used = json::object();
+    bool ok = true;
+    for (std::size_t s = 0; s < kSlotCount; ++s) {
+      json block = contact.contains(kSlotNames[s]) ? contact[kSlotNames[s]] : json{{"model", kDefaultSlotModel[s]}};
+      const std::string model = block["model"].get<std::string>();
+      if (model == "none") continue;
+      const RegisteredModel* m = registry.find(kSlotKinds[s], model);
+      const std::string where = base + "/contact/" + kSlotNames[s];
+      if (!m) {  // a default the loaded plugins do not provide
+        ck.add(where, std::string("no ") + kSlotNames[s] + " model '" + model + "' is loaded",
+               suggest(model, registry.names(kSlotKinds[s])));
+        ok = false;
+        continue;
+      }
+      try {
+        slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), file.string() + ": at " + where);
+      } catch (const PluginError& e) {
+        ck.add(where, e.what());
+        ok = false;
+        continue;
+      }
+      used[kSlotNames[s]] = {{"model", model},
+                             {"version", m->version},
+                             {"library", registry.libraries()[m->library].name},
+                             {"library_version", registry.libraries()[m->library].version}};
+    }
+    if (!ok) continue;
+    sim->models_used[sd_name] = used;
+    auto sub = std::make_unique<Subdomain>(sd_name, alpha, mat_index.at(mat_name),
+                                           std::make_unique<ContactPipeline>(std::move(slots)));
+    std::vector<PairCoefficients> wall_coeffs;
+    for (const auto& w : sim->walls)
+      wall_coeffs.push_back(coeffs.at(std::minmax(mat_name, sim->materials[w.material].name)));
+    sub->set_environment(sim->materials, wall_coeffs, coeffs.at(std::minmax(mat_name, mat_name)), &sim->walls,
+                         sim->gravity);
+
+    // insertion
+    if (sd.contains("insert")) {
+      for (std::size_t q = 0; q < sd["insert"].size(); ++q) {
+        const json& block = sd["insert"][q];
+        const std::string where = idx(base + "/insert", q);
+        const RegisteredModel* m = registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
+        try {
+          ModelInstance inst(*m, plugin_params(block, DOMEL_KIND_INSERTION), file.string() + ": at " + where);
+          ParticleStore& st = sub->store();
+          domel_insert_request_v1 req{};
+          req.struct_size = sizeof(req);
+          req.region = make_region(block["region"]);
+          req.seed = block.contains("seed") ? block["seed"].get<std::uint64_t>()
+                                            : sim->seed * 1000003ull + k * 1009ull + q;
+          req.length_scale = alpha;
+          req.n_existing = st.size();
+          req.ex_x = st.x.data(); req.ex_y = st.y.data(); req.ex_z = st.z.data(); req.ex_r = st.radius.data();
+          std::vector<double> x, y, z, r;
+          inst.insert(req, x, y, z, r);
+          double v[3] = {0, 0, 0};
+          if (block.contains("velocity"))
+            for (int a = 0; a < 3; ++a) v[a] = block["velocity"][a].get<double>();
+          const double density = sim->materials[mat_index.at(mat_name)].density;
+          for (std::size_t p = 0; p < x.size(); ++p) {
+            st.add(next_id++, x[p], y[p], z[p], r[p], density);
+            st.vx.back() = v[0]; st.vy.back() = v[1]; st.vz.back() = v[2];
+          }
+          spdlog::info("subdomain '{}': inserted {} particles with '{}' ({})", sd_name, x.size(), m->name, where);
+          if (x.empty()) spdlog::warn("subdomain '{}': {} inserted no particles", sd_name, where);
+        } catch (const PluginError& e) {
+          ck.add(where, e.what());
+        }
+      }
+    }
+
+    // neighbour skin: fraction of the largest diameter
+    double rmax = 0;
+    for (double r : sub->store().radius) rmax = std::max(rmax, r);
+    sub->set_skin(sd.value("skin", 0.5) * 2.0 * (rmax > 0 ? rmax : 1e-3));
+
+    // time step
+    const double v_imp = sd.value("impact_velocity", 1.0);
+    TimeStepReport rep = sub->estimate_time_step(v_imp);
+    const json ts = sd.value("time_step", json("auto"));
+    if (sub->store().size() == 0) {
+      if (!ts.is_number()) {
+        ck.add(base + "/time_step", "cannot choose a time step automatically for a subdomain without particles",
+               "give time_step in seconds");
+        continue;
+      }
+      rep.chosen = ts.get<double>();
+      rep.reason = "given (no particles to check it against)";
+    } else if (ts.is_number()) {
+      rep.chosen = ts.get<double>();
+      rep.reason = "given";
+      if (rep.chosen > rep.critical) {
+        ck.add(base + "/time_step",
+               "time step " + fmt_num(rep.chosen) + " s exceeds the explicit stability limit " + fmt_num(rep.critical) +
+                   " s set by the " + rep.critical_of + " (impact velocity " + fmt_num(v_imp) + " m/s, contact time " +
+                   fmt_num(rep.contact_time) + " s)",
+               "use at most " + fmt_num(rep.critical) + " s, or \"auto\"");
+        continue;
+      }
+      if (rep.chosen > rep.contact_time / 20.0)
+        spdlog::warn("subdomain '{}': time step {:.3g} s resolves a collision ({:.3g} s) with only {:.0f} steps; "
+                     "expect inaccurate restitution (20-50 steps per contact are usual)",
+                     sd_name, rep.chosen, rep.contact_time, rep.contact_time / rep.chosen);
+    } else {
+      rep.chosen = std::min(0.2 * rep.rayleigh, rep.contact_time / 50.0);
+      rep.chosen = std::min(rep.chosen, rep.critical);
+      rep.reason = rep.chosen == 0.2 * rep.rayleigh ? "auto: 0.2 x Rayleigh time" : "auto: contact time / 50";
+    }
+    sub->set_time_step(rep.chosen);
+    spdlog::info("subdomain '{}': {} particles, time step {:.4g} s ({}); Rayleigh time {:.4g} s, contact time {:.4g} s "
+                 "at {:.3g} m/s, stability limit {:.4g} s ({})",
+                 sd_name, sub->store().size(), rep.chosen, rep.reason, rep.rayleigh, rep.contact_time, v_imp,
+                 rep.critical, rep.critical_of);
+    sim->time_steps.push_back(rep);
+    sim->subdomains.push_back(std::move(sub));
+  }
+  if (!ck.diags.empty()) throw ConfigError(ck.diags);
+
+  if (run.contains("duration")) {
+    sim->duration = run["duration"].get<double>();
+  } else {
+    sim->duration = static_cast<double>(run["steps"].get<std::uint64_t>()) * sim->macro_step();
+  }
+  const json out = doc.value("output", json::object());
+  sim->output_directory = out.value("directory", sim->name + "_out");
+  sim->vtk_interval = out.value("vtk_interval", sim->duration / 50.0);
+  sim->probe_interval = out.value("probe_interval", sim->duration / 500.0);
+  return sim;
+}
+
+}  // namespace
+
+std::vector<Diagnostic> validate_scenario_file(const std::filesystem::path& file, PluginRegistry& registry) {
+  std::vector<Diagnostic> diags;
+  const json doc = read_json_file(file, diags);
+  if (!diags.empty()) return diags;
+  return validate_document(doc, file, registry);
+}
+
+std::unique_ptr<Simulation> load_scenario(const nlohmann::json& doc, const std::filesystem::path& file,
+                                          PluginRegistry& registry) {
+  auto diags = validate_document(doc, file, registry);
+  if (!diags.empty()) throw ConfigError(diags);
+  return build(doc, file, registry);
+}
+
+std::unique_ptr<Simulation> load_scenario(const std::filesystem::path& file, PluginRegistry& registry) {
+  std::vector<Diagnostic> diags;
+  const json doc = read_json_file(file, diags);
+  if (!diags.empty()) throw ConfigError(diags);
+  return load_scenario(doc, file, registry);
+}
+
+}  // namespace domel::platform

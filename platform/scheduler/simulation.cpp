@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: MIT
+// The run loop: multi-rate stepping of subdomains, outputs and progress.
+#include "scheduler/simulation.hpp"
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/csv_series.hpp"
+#include "io/vtk_writer.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <unistd.h>
+
+namespace domel::platform {
+
+double Simulation::macro_step() const {
+  double dt = 0;
+  for (const auto& sd : subdomains) dt = std::max(dt, sd->time_step());
+  return dt;
+}
+
+namespace {
+
+std::string format_seconds(double s) {
+  char buf[32];
+  if (s < 60) std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else if (s < 3600) std::snprintf(buf, sizeof buf, "%.0f min %02.0f s", std::floor(s / 60), std::fmod(s, 60));
+  else std::snprintf(buf, sizeof buf, "%.0f h %02.0f min", std::floor(s / 3600), std::fmod(s / 60, 60));
+  return buf;
+}
+
+std::string iso_time_now() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+}  // namespace
+
+RunResult Simulation::run(const RunOptions& options, const PluginRegistry& registry) {
+  RunResult result;
+  const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
+  result.output_directory = out;
+  std::filesystem::create_directories(out);
+  const int threads_requested = options.threads > 0 ? options.threads : threads;
+  if (threads_requested > 1)
+    spdlog::warn("{} threads requested: this release runs the force loop on one thread "
+                 "(the thread-parallel loop is part of the performance work)", threads_requested);
+
+  // Multi-rate: the macro step is the largest subdomain step; finer subdomains
+  // sub-cycle with dt_k = macro / n_k (n_k rounded up, so no step grows).
+  const double macro = macro_step();
+  std::vector<int> substeps;
+  for (auto& sd : subdomains) {
+    const int n = std::max(1, static_cast<int>(std::ceil(macro / sd->time_step() - 1e-9)));
+    if (std::fabs(macro / n - sd->time_step()) > 1e-12 * macro) {
+      spdlog::info("subdomain '{}': time step adjusted from {:.6g} s to {:.6g} s = macro step / {}", sd->name(),
+                   sd->time_step(), macro / n, n);
+      sd->set_time_step(macro / n);
+    }
+    substeps.push_back(n);
+    sd->setup();
+  }
+  const std::uint64_t total_macro = static_cast<std::uint64_t>(std::ceil(duration / macro - 1e-9));
+
+  // Outputs.
+  std::vector<std::string> columns = {"time"};
+  for (const auto& sd : subdomains)
+    for (const char* c : {"particles", "ke_translational", "ke_rotational", "mean_angular_speed",
+                          "max_overlap_ratio", "contacts", "wall_contacts"})
+      columns.push_back(sd->name() + "." + c);
+  std::unique_ptr<io::CsvSeries> probes;
+  if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
+  std::unique_ptr<io::VtkSeriesWriter> vtk;
+  if (vtk_interval > 0) vtk = std::make_unique<io::VtkSeriesWriter>(out, "particles");
+  auto write_probes = [&](double t) {
+    std::vector<double> row = {t};
+    for (const auto& sd : subdomains) {
+      const SubdomainStats st = sd->stats();
+      row.insert(row.end(), {static_cast<double>(st.particles), st.kinetic_translational, st.kinetic_rotational,
+                             st.mean_angular_speed, st.max_overlap_ratio, static_cast<double>(st.contacts),
+                             static_cast<double>(st.wall_contacts)});
+    }
+    probes->append(row);
+  };
+  auto write_vtk = [&](double t) {
+    std::vector<io::ParticleSet> sets;
+    for (std::size_t k = 0; k < subdomains.size(); ++k)
+      sets.push_back({&subdomains[k]->store(), static_cast<int>(k)});
+    vtk->write(t, sets);
+  };
+
+  std::size_t particles = 0;
+  for (const auto& sd : subdomains) particles += sd->store().size();
+  spdlog::info("running '{}': {} particles in {} subdomain(s), {:.6g} s simulated in {} macro steps of {:.4g} s -> {}",
+               name, particles, subdomains.size(), duration, total_macro, macro, out.string());
+
+  double next_vtk = 0, next_probe = 0;
+  const auto start = std::chrono::steady_clock::now();
+  auto last_report = start;
+  const bool tty = isatty(fileno(stderr));
+  double particle_steps = 0;
+  std::uint64_t m = 0;
+  const std::uint64_t stop = options.max_steps ? std::min(options.max_steps, total_macro) : total_macro;
+  for (;; ++m) {
+    const double t = static_cast<double>(m) * macro;
+    if (probes && t >= next_probe - 1e-9 * macro) {
+      write_probes(t);
+      next_probe += probe_interval;
+    }
+    if (vtk && t >= next_vtk - 1e-9 * macro) {
+      write_vtk(t);
+      next_vtk += vtk_interval;
+    }
+    if (m == stop) break;
+    for (std::size_t k = 0; k < subdomains.size(); ++k) {
+      for (int s = 0; s < substeps[k]; ++s) subdomains[k]->step();
+      particle_steps += static_cast<double>(substeps[k]) * subdomains[k]->store().size();
+    }
+    const auto now = std::chrono::steady_clock::now();
+    const double since = std::chrono::duration<double>(now - last_report).count();
+    if (options.progress && since >= (tty ? 1.0 : 10.0)) {
+      last_report = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const double rate = (m + 1) / elapsed;
+      const double eta = (stop - m - 1) / rate;
+      std::fprintf(stderr, "%s[domel] t = %.4g / %.4g s (%3.0f%%) | %.0f steps/s | %.3g particle-steps/s | ETA %s%s",
+                   tty ? "\r" : "", (m + 1) * macro, stop * macro, 100.0 * (m + 1) / stop, rate,
+                   particle_steps / elapsed, format_seconds(eta).c_str(), tty ? "   " : "\n");
+      std::fflush(stderr);
+    }
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (options.progress && tty) std::fprintf(stderr, "\n");
+  if (probes) probes->flush();
+
+  result.macro_steps = m;
+  result.simulated_time = static_cast<double>(m) * macro;
+  result.wall_seconds = wall;
+  result.particle_steps_per_second = wall > 0 ? particle_steps / wall : 0;
+
+  nlohmann::json summary;
+  summary["domel_version"] = DOMEL_VERSION;
+  summary["sdk_abi"] = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR);
+  summary["scenario"] = {{"name", name}, {"file", scenario_file.string()}};
+  summary["finished"] = iso_time_now();
+  summary["threads"] = {{"requested", threads_requested}, {"used", 1}};
+  summary["seed"] = seed;
+  summary["steps"] = m;
+  summary["simulated_time_s"] = result.simulated_time;
+  summary["wall_time_s"] = wall;
+  summary["particles"] = particles;
+  summary["particle_steps_per_s"] = result.particle_steps_per_second;
+  nlohmann::json libs = nlohmann::json::array();
+  for (const auto& lib : registry.libraries())
+    libs.push_back({{"name", lib.name}, {"version", lib.version}, {"path", lib.path.string()},
+                    {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)}});
+  summary["plugin_libraries"] = libs;
+  summary["models"] = models_used;
+  nlohmann::json sds = nlohmann::json::array();
+  for (std::size_t k = 0; k < subdomains.size(); ++k) {
+    const auto& sd = subdomains[k];
+    const SubdomainStats st = sd->stats();
+    sds.push_back({{"name", sd->name()},
+                   {"coarse_grain", sd->coarse_grain()},
+                   {"particles", st.particles},
+                   {"time_step_s", sd->time_step()},
+                   {"time_step_reason", time_steps[k].reason},
+                   {"rayleigh_time_s", time_steps[k].rayleigh},
+                   {"contact_time_s", time_steps[k].contact_time},
+                   {"stability_limit_s", time_steps[k].critical},
+                   {"steps", sd->steps()},
+                   {"neighbor_list_builds", sd->neighbor_builds()},
+                   {"final", {{"ke_translational_J", st.kinetic_translational},
+                              {"ke_rotational_J", st.kinetic_rotational},
+                              {"mean_angular_speed", st.mean_angular_speed},
+                              {"max_overlap_ratio", st.max_overlap_ratio},
+                              {"contacts", st.contacts},
+                              {"wall_contacts", st.wall_contacts}}}});
+  }
+  summary["subdomains"] = sds;
+  nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
+  summary["outputs"] = files;
+  io::write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
+  result.summary = summary;
+  spdlog::info("done: {} steps, {:.6g} s simulated in {:.3g} s wall ({:.3g} particle-steps/s)", m,
+               result.simulated_time, wall, result.particle_steps_per_second);
+  return result;
+}
+
+}  // namespace domel::platform

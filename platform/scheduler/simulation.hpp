@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: MIT
+// A built, validated scenario and the loop that runs it: subdomains advance
+// at their own time steps inside a common macro step (a coarse subdomain
+// takes one large step while a finer one sub-cycles), outputs are written
+// at fixed simulated-time intervals, and progress is reported.
+#pragma once
+
+#include "core/material.hpp"
+#include "geometry/wall.hpp"
+#include "loader/plugin_registry.hpp"
+#include "subdomain/subdomain.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace domel::platform {
+
+struct RunOptions {
+  std::filesystem::path output_directory;  ///< empty: the scenario's choice
+  int threads = 0;                         ///< 0: the scenario's choice
+  bool progress = true;
+  std::uint64_t max_steps = 0;             ///< 0: run to the end; otherwise stop early (smoke tests)
+};
+
+struct RunResult {
+  std::uint64_t macro_steps = 0;
+  double simulated_time = 0;
+  double wall_seconds = 0;
+  double particle_steps_per_second = 0;
+  std::filesystem::path output_directory;
+  nlohmann::json summary;
+};
+
+class Simulation {
+ public:
+  std::string name;
+  std::filesystem::path scenario_file;
+  std::vector<Material> materials;
+  std::vector<WallPrimitive> walls;
+  std::vector<std::unique_ptr<Subdomain>> subdomains;
+  std::vector<TimeStepReport> time_steps;  ///< per subdomain
+  double gravity[3] = {0, 0, -9.81};
+  double duration = 0;
+  std::uint64_t seed = 1;
+  int threads = 1;
+  double vtk_interval = 0;
+  double probe_interval = 0;
+  std::filesystem::path output_directory;
+  nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
+
+  /// Run to the end. Throws RuntimeError or PluginError on failure; every
+  /// file written up to then is complete (written to a temporary name and renamed).
+  RunResult run(const RunOptions& options, const PluginRegistry& registry);
+
+  /// The macro step and each subdomain's number of sub-steps within it.
+  double macro_step() const;
+};
+
+}  // namespace domel::platform

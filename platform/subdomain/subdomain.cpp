@@ -1,0 +1,340 @@
+// SPDX-License-Identifier: MIT
+// Force evaluation and velocity-Verlet integration of one subdomain.
+//
+// Contact geometry (docs/physics.md notation): n points from j to i,
+// overlap delta = R_i + R_j - |x_i - x_j|. The lever arm from a particle
+// centre to the contact point is c_i = R_i - delta/2 for a particle pair
+// (the middle of the overlap, as LIGGGHTS' c_ri) and c_i = R_i - delta for a
+// wall (the contact point lies on the wall surface).
+// Relative velocity of the contact points: v_c = (v_i + w_i x (-c_i n)) - (v_j + w_j x (c_j n)).
+// Forces: F_i = F_n n + F_t, F_j = -F_i. Torques: T_i = -c_i n x F_t + M,
+// T_j = -c_j n x F_t - M (M: rolling/twisting couple on i).
+#include "subdomain/subdomain.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace domel::platform {
+
+Subdomain::Subdomain(std::string name, double coarse_grain, std::size_t material,
+                     std::unique_ptr<ContactPipeline> pipeline)
+    : name_(std::move(name)), coarse_grain_(coarse_grain), material_(material), pipeline_(std::move(pipeline)) {
+  batch_entry_.resize(ContactPipeline::kBatchSize);
+  batch_ci_.resize(ContactPipeline::kBatchSize);
+  batch_cj_.resize(ContactPipeline::kBatchSize);
+}
+
+void Subdomain::set_environment(const std::vector<Material>& materials,
+                                const std::vector<PairCoefficients>& wall_pairs, const PairCoefficients& self_pair,
+                                const std::vector<WallPrimitive>* walls, const double gravity[3]) {
+  own_material_ = materials.at(material_);
+  walls_ = walls;
+  self_pair_ = make_pair(own_material_, own_material_, self_pair, false, coarse_grain_);
+  wall_pairs_.clear();
+  for (std::size_t w = 0; w < walls->size(); ++w)
+    wall_pairs_.push_back(make_pair(own_material_, materials.at((*walls)[w].material), wall_pairs.at(w), true,
+                                    coarse_grain_));
+  wall_lists_.assign(walls->size(), WallNeighbors{});
+  for (int a = 0; a < 3; ++a) gravity_[a] = gravity[a];
+}
+
+TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
+  TimeStepReport rep;
+  if (store_.size() == 0) return rep;
+  std::size_t smallest = 0;
+  for (std::size_t k = 1; k < store_.size(); ++k)
+    if (store_.radius[k] < store_.radius[smallest]) smallest = k;
+  const double r = store_.radius[smallest];
+  const double m = store_.mass[smallest];
+  // Rayleigh time, docs/physics.md §1.3.
+  const double nu = own_material_.poisson_ratio;
+  const double g_mod = own_material_.youngs_modulus / (2.0 * (1.0 + nu));
+  rep.rayleigh = M_PI * r * std::sqrt(own_material_.density / g_mod) / (0.1631 * nu + 0.8766);
+
+  auto& buf = pipeline_->buffers();
+  auto collide = [&](const domel_pair_v1& pair, double r_eff, double m_eff, double& t_contact, double& dt_crit) {
+    // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
+    // contact opens, with a step refined until the duration converges.
+    double h = 1e-3 * r_eff / impact_velocity;
+    double previous = -1.0;
+    for (int refine = 0; refine < 12; ++refine) {
+      double delta = 0.0, v = impact_velocity, t = 0.0, crit = 1e300;
+      auto force = [&](double d, double vel) {
+        buf.overlap[0] = std::max(d, 1e-300);
+        buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_eff; buf.radius_j[0] = 0;
+        buf.nx[0] = 0; buf.ny[0] = 0; buf.nz[0] = 1; buf.vn[0] = vel;
+        buf.vtx[0] = buf.vty[0] = buf.vtz[0] = 0; buf.wx[0] = buf.wy[0] = buf.wz[0] = 0;
+        std::fill(buf.history.begin(), buf.history.end(), 0.0);
+        pipeline_->evaluate(pair, h, 1);
+        const double k = buf.kn_tangent[0];
+        if (k > 0) {
+          const double omega = std::sqrt(k / m_eff);
+          const double zeta = buf.eta_n[0] / (2.0 * std::sqrt(m_eff * k));
+          crit = std::min(crit, 2.0 * (std::sqrt(1.0 + zeta * zeta) - zeta) / omega);
+        }
+        return buf.fn[0];
+      };
+      double a = -force(delta, v) / m_eff;
+      std::size_t n = 0;
+      do {
+        v += 0.5 * h * a;
+        delta += h * v;
+        a = -force(delta, v) / m_eff;
+        v += 0.5 * h * a;
+        t += h;
+        ++n;
+      } while (delta > 0.0 && n < 2000000);
+      t_contact = t;
+      dt_crit = crit;
+      if (previous > 0 && std::fabs(t - previous) < 1e-3 * t) break;
+      previous = t;
+      if (n > 4000) break;  // resolved well enough
+      h *= 0.25;
+    }
+    std::fill(buf.history.begin(), buf.history.end(), 0.0);
+  };
+  double tc, crit;
+  collide(self_pair_, 0.5 * r, 0.5 * m, tc, crit);
+  rep.contact_time = tc;
+  rep.critical = crit;
+  rep.critical_of = "particle-particle contact";
+  for (std::size_t w = 0; w < wall_pairs_.size(); ++w) {
+    collide(wall_pairs_[w], r, m, tc, crit);
+    rep.contact_time = std::min(rep.contact_time, tc);
+    if (crit < rep.critical) {
+      rep.critical = crit;
+      rep.critical_of = "contact with wall '" + (*walls_)[w].name + "'";
+    }
+  }
+  return rep;
+}
+
+void Subdomain::setup() {
+  const uint32_t stride = pipeline_->history_stride();
+  nlist_.configure(skin_, stride);
+  rebuild_lists();
+  compute_forces();
+}
+
+void Subdomain::rebuild_lists() {
+  nlist_.build(store_);
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w)
+    wall_lists_[w].build(store_, (*walls_)[w], skin_, pipeline_->history_stride());
+}
+
+void Subdomain::step() {
+  const std::size_t n = store_.size();
+  const double dt = dt_, half = 0.5 * dt_;
+  ParticleStore& s = store_;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
+    s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
+    s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
+    s.x[k] += dt * s.vx[k]; s.y[k] += dt * s.vy[k]; s.z[k] += dt * s.vz[k];
+  }
+  if (nlist_.needs_rebuild(s)) rebuild_lists();
+  compute_forces();
+  bool finite = true;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
+    s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
+    s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
+    finite &= std::isfinite(s.x[k] + s.y[k] + s.z[k] + s.vx[k] + s.vy[k] + s.vz[k]);
+  }
+  time_ += dt;
+  ++steps_;
+  if (!finite) {
+    std::ostringstream os;
+    os << "subdomain '" << name_ << "': a particle position or velocity became non-finite at t = " << time_
+       << " s (step " << steps_ << "); the time step " << dt_ << " s is probably too large for the contact model";
+    throw RuntimeError(os.str());
+  }
+}
+
+void Subdomain::compute_forces() {
+  ParticleStore& s = store_;
+  const std::size_t n = s.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    s.fx[k] = s.mass[k] * gravity_[0];
+    s.fy[k] = s.mass[k] * gravity_[1];
+    s.fz[k] = s.mass[k] * gravity_[2];
+    s.tx[k] = s.ty[k] = s.tz[k] = 0.0;
+    s.contacts[k] = 0;
+  }
+  last_max_overlap_ratio_ = 0;
+  pair_forces();
+  wall_forces();
+}
+
+void Subdomain::pair_forces() {
+  ParticleStore& s = store_;
+  auto& buf = pipeline_->buffers();
+  const uint32_t stride = nlist_.stride();
+  const std::size_t npairs = nlist_.size();
+  std::size_t contacts = 0;
+  double max_ratio = 0.0;
+  uint32_t c = 0;
+
+  auto flush = [&]() {
+    if (c == 0) return;
+    pipeline_->evaluate(self_pair_, dt_, c);
+    for (uint32_t q = 0; q < c; ++q) {
+      const uint32_t e = batch_entry_[q];
+      const uint32_t i = nlist_.i[e], j = nlist_.j[e];
+      const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
+      const double fn = buf.fn[q];
+      const double ftx = buf.ftx[q], fty = buf.fty[q], ftz = buf.ftz[q];
+      const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
+      s.fx[i] += fx; s.fy[i] += fy; s.fz[i] += fz;
+      s.fx[j] -= fx; s.fy[j] -= fy; s.fz[j] -= fz;
+      // n x F_t
+      const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
+      const double ci = batch_ci_[q], cj = batch_cj_[q];
+      s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
+      s.tx[j] += -cj * cx - buf.tqx[q]; s.ty[j] += -cj * cy - buf.tqy[q]; s.tz[j] += -cj * cz - buf.tqz[q];
+      ++s.contacts[i];
+      ++s.contacts[j];
+      if (stride) std::copy_n(buf.history.begin() + q * stride, stride, nlist_.history.begin() + e * stride);
+    }
+    contacts += c;
+    c = 0;
+  };
+
+  for (std::size_t e = 0; e < npairs; ++e) {
+    const uint32_t i = nlist_.i[e], j = nlist_.j[e];
+    const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
+    const double rsum = s.radius[i] + s.radius[j];
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 >= rsum * rsum) {
+      if (nlist_.touching[e]) {
+        nlist_.touching[e] = 0;
+        std::fill_n(nlist_.history.begin() + e * stride, stride, 0.0);
+      }
+      continue;
+    }
+    const double dist = std::sqrt(d2);
+    const double inv = 1.0 / dist;
+    const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+    const double delta = rsum - dist;
+    const double ci = s.radius[i] - 0.5 * delta, cj = s.radius[j] - 0.5 * delta;
+    // contact-point velocities: v_i + w_i x (-ci n) and v_j + w_j x (cj n)
+    const double vix = s.vx[i] - ci * (s.wy[i] * nz - s.wz[i] * ny);
+    const double viy = s.vy[i] - ci * (s.wz[i] * nx - s.wx[i] * nz);
+    const double viz = s.vz[i] - ci * (s.wx[i] * ny - s.wy[i] * nx);
+    const double vjx = s.vx[j] + cj * (s.wy[j] * nz - s.wz[j] * ny);
+    const double vjy = s.vy[j] + cj * (s.wz[j] * nx - s.wx[j] * nz);
+    const double vjz = s.vz[j] + cj * (s.wx[j] * ny - s.wy[j] * nx);
+    const double rx = vix - vjx, ry = viy - vjy, rz = viz - vjz;
+    const double vdotn = rx * nx + ry * ny + rz * nz;
+    buf.overlap[c] = delta;
+    buf.nx[c] = nx; buf.ny[c] = ny; buf.nz[c] = nz;
+    buf.radius_i[c] = s.radius[i];
+    buf.radius_j[c] = s.radius[j];
+    buf.r_eff[c] = s.radius[i] * s.radius[j] / rsum;
+    buf.m_eff[c] = s.mass[i] * s.mass[j] / (s.mass[i] + s.mass[j]);
+    buf.vn[c] = -vdotn;
+    buf.vtx[c] = rx - vdotn * nx; buf.vty[c] = ry - vdotn * ny; buf.vtz[c] = rz - vdotn * nz;
+    buf.wx[c] = s.wx[i] - s.wx[j]; buf.wy[c] = s.wy[i] - s.wy[j]; buf.wz[c] = s.wz[i] - s.wz[j];
+    if (stride) std::copy_n(nlist_.history.begin() + e * stride, stride, buf.history.begin() + c * stride);
+    nlist_.touching[e] = 1;
+    batch_entry_[c] = static_cast<uint32_t>(e);
+    batch_ci_[c] = ci;
+    batch_cj_[c] = cj;
+    max_ratio = std::max(max_ratio, delta / rsum);
+    if (++c == ContactPipeline::kBatchSize) flush();
+  }
+  flush();
+  last_contacts_ = contacts;
+  last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, max_ratio);
+}
+
+void Subdomain::wall_forces() {
+  ParticleStore& s = store_;
+  auto& buf = pipeline_->buffers();
+  const uint32_t stride = pipeline_->history_stride();
+  std::size_t contacts = 0;
+  double max_ratio = 0.0;
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
+    WallNeighbors& list = wall_lists_[w];
+    const WallPrimitive& wall = (*walls_)[w];
+    uint32_t c = 0;
+    auto flush = [&]() {
+      if (c == 0) return;
+      pipeline_->evaluate(wall_pairs_[w], dt_, c);
+      for (uint32_t q = 0; q < c; ++q) {
+        const uint32_t e = batch_entry_[q];
+        const uint32_t i = list.particle[e];
+        const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
+        const double fn = buf.fn[q];
+        const double ftx = buf.ftx[q], fty = buf.fty[q], ftz = buf.ftz[q];
+        s.fx[i] += fn * nx + ftx; s.fy[i] += fn * ny + fty; s.fz[i] += fn * nz + ftz;
+        const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
+        const double ci = batch_ci_[q];
+        s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
+        ++s.contacts[i];
+        if (stride) std::copy_n(buf.history.begin() + q * stride, stride, list.history.begin() + e * stride);
+      }
+      contacts += c;
+      c = 0;
+    };
+    for (std::size_t e = 0; e < list.particle.size(); ++e) {
+      const uint32_t i = list.particle[e];
+      double d, nx, ny, nz;
+      const bool has = wall.gap(s.x[i], s.y[i], s.z[i], d, nx, ny, nz);
+      if (!has || d >= s.radius[i]) {
+        if (list.touching[e]) {
+          list.touching[e] = 0;
+          std::fill_n(list.history.begin() + e * stride, stride, 0.0);
+        }
+        continue;
+      }
+      const double delta = s.radius[i] - d;
+      const double ci = s.radius[i] - delta;
+      const double rx = s.vx[i] - ci * (s.wy[i] * nz - s.wz[i] * ny);
+      const double ry = s.vy[i] - ci * (s.wz[i] * nx - s.wx[i] * nz);
+      const double rz = s.vz[i] - ci * (s.wx[i] * ny - s.wy[i] * nx);
+      const double vdotn = rx * nx + ry * ny + rz * nz;
+      buf.overlap[c] = delta;
+      buf.nx[c] = nx; buf.ny[c] = ny; buf.nz[c] = nz;
+      buf.radius_i[c] = s.radius[i];
+      buf.radius_j[c] = 0.0;
+      buf.r_eff[c] = s.radius[i];
+      buf.m_eff[c] = s.mass[i];
+      buf.vn[c] = -vdotn;
+      buf.vtx[c] = rx - vdotn * nx; buf.vty[c] = ry - vdotn * ny; buf.vtz[c] = rz - vdotn * nz;
+      buf.wx[c] = s.wx[i]; buf.wy[c] = s.wy[i]; buf.wz[c] = s.wz[i];
+      if (stride) std::copy_n(list.history.begin() + e * stride, stride, buf.history.begin() + c * stride);
+      list.touching[e] = 1;
+      batch_entry_[c] = static_cast<uint32_t>(e);
+      batch_ci_[c] = ci;
+      max_ratio = std::max(max_ratio, delta / (2.0 * s.radius[i]));
+      if (++c == ContactPipeline::kBatchSize) flush();
+    }
+    flush();
+  }
+  last_wall_contacts_ = contacts;
+  last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, max_ratio);
+}
+
+SubdomainStats Subdomain::stats() const {
+  SubdomainStats st;
+  const ParticleStore& s = store_;
+  st.particles = s.size();
+  st.contacts = last_contacts_;
+  st.wall_contacts = last_wall_contacts_;
+  st.max_overlap_ratio = last_max_overlap_ratio_;
+  double sum_w = 0;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    st.kinetic_translational += 0.5 * s.mass[k] * (s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k]);
+    const double w2 = s.wx[k] * s.wx[k] + s.wy[k] * s.wy[k] + s.wz[k] * s.wz[k];
+    st.kinetic_rotational += 0.5 * w2 / s.inv_inertia[k];
+    sum_w += std::sqrt(w2);
+  }
+  if (s.size()) st.mean_angular_speed = sum_w / s.size();
+  return st;
+}
+
+}  // namespace domel::platform

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: MIT
+// One resolution level: its particle store, coarse-grain ratio, material,
+// contact model (slot pipeline), neighbour lists and time step. The per-step
+// hot path lives here and reads top to bottom:
+//   step(): half kick -> drift -> (rebuild lists) -> forces -> half kick
+//   compute_forces(): gravity, particle pairs in batches, walls in batches.
+// Subdomains of one scenario do not touch each other's particles; coupling
+// operators (a later stage) exchange cell averages between them.
+#pragma once
+
+#include "contact/contact_pipeline.hpp"
+#include "core/material.hpp"
+#include "core/neighbor_list.hpp"
+#include "core/particle_store.hpp"
+#include "geometry/wall.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace domel::platform {
+
+/// Observables of the last force evaluation and the current state.
+struct SubdomainStats {
+  std::size_t particles = 0;
+  std::size_t contacts = 0;          ///< particle-particle contacts
+  std::size_t wall_contacts = 0;
+  double kinetic_translational = 0;  ///< [J]
+  double kinetic_rotational = 0;     ///< [J]
+  double mean_angular_speed = 0;     ///< mean |omega| [rad/s]
+  double max_overlap_ratio = 0;      ///< max delta / (mean diameter of the pair), walls: delta / d
+};
+
+struct TimeStepReport {
+  double rayleigh = 0;       ///< Rayleigh time of the smallest particle [s]
+  double contact_time = 0;   ///< shortest simulated collision at the impact velocity [s]
+  double critical = 0;       ///< explicit stability limit 2/omega (damped) of the stiffest contact [s]
+  std::string critical_of;   ///< which contact sets it ("particle-particle", "wall 'x'")
+  double chosen = 0;         ///< [s]
+  std::string reason;
+};
+
+class Subdomain {
+ public:
+  Subdomain(std::string name, double coarse_grain, std::size_t material, std::unique_ptr<ContactPipeline> pipeline);
+
+  const std::string& name() const { return name_; }
+  double coarse_grain() const { return coarse_grain_; }
+  std::size_t material() const { return material_; }
+  ContactPipeline& pipeline() { return *pipeline_; }
+  ParticleStore& store() { return store_; }
+  const ParticleStore& store() const { return store_; }
+
+  /// Wire materials and walls (pairs are derived once). Call before setup().
+  void set_environment(const std::vector<Material>& materials, const std::vector<PairCoefficients>& wall_pairs,
+                       const PairCoefficients& self_pair, const std::vector<WallPrimitive>* walls,
+                       const double gravity[3]);
+  void set_skin(double skin) { skin_ = skin; }
+  double skin() const { return skin_; }
+  void set_time_step(double dt) { dt_ = dt; }
+  double time_step() const { return dt_; }
+
+  /// Estimate contact time and stability limit from the contact model itself:
+  /// a head-on collision at `impact_velocity` is integrated with the normal
+  /// and damping stages (particle-particle and each wall).
+  TimeStepReport estimate_time_step(double impact_velocity);
+
+  /// Build neighbour lists and evaluate forces at the current state.
+  void setup();
+  /// One velocity-Verlet step of dt.
+  void step();
+
+  double time() const { return time_; }
+  std::uint64_t steps() const { return steps_; }
+  std::size_t neighbor_builds() const { return nlist_.builds(); }
+  SubdomainStats stats() const;
+
+ private:
+  void rebuild_lists();
+  void compute_forces();
+  void pair_forces();
+  void wall_forces();
+
+  std::string name_;
+  double coarse_grain_;
+  std::size_t material_;
+  std::unique_ptr<ContactPipeline> pipeline_;
+  ParticleStore store_;
+  NeighborList nlist_;
+  std::vector<WallNeighbors> wall_lists_;
+  const std::vector<WallPrimitive>* walls_ = nullptr;
+  std::vector<domel_pair_v1> wall_pairs_;
+  domel_pair_v1 self_pair_{};
+  Material own_material_;
+  double gravity_[3] = {0, 0, 0};
+  double skin_ = 0;
+  double dt_ = 0;
+  double time_ = 0;
+  std::uint64_t steps_ = 0;
+  std::size_t last_contacts_ = 0, last_wall_contacts_ = 0;
+  double last_max_overlap_ratio_ = 0;
+  // scratch of one batch: which list entry and the lever arms
+  std::vector<uint32_t> batch_entry_;
+  std::vector<double> batch_ci_, batch_cj_;
+};
+
+}  // namespace domel::platform
