@@ -29,9 +29,11 @@ constexpr int kExitUsage = 64;
 const char* kUsage = R"(usage: domel <command> [options]
 
 commands:
-  run FILE [--out DIR] [--threads N] [--max-steps N] [--quiet] [--verbose]
+  run FILE [--out DIR] [--threads N] [--max-steps N] [--time-after N] [--quiet] [--verbose]
                       validate and run a scenario; writes particles_*.vtp + particles.pvd
-                      (ParaView), probes.csv and summary.json into the output folder
+                      (ParaView), probes.csv and summary.json into the output folder.
+                      --max-steps stops early; --time-after N also reports the speed of
+                      the steps after the first N (benchmarks, in summary.json)
   validate FILE...    check scenarios without running them; lists every problem
   plugins [--json]    list loaded plugin models with versions, ABI and parameters
   schema [--out FILE] print the complete scenario JSON Schema (for editors, via "$schema")
@@ -110,7 +112,7 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
 }
 
 int cmd_run(int argc, char** argv) {
-  const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps"}, {"--quiet", "--verbose"});
+  const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps", "--time-after"}, {"--quiet", "--verbose"});
   if (a.positional.size() != 1) throw UsageError("run expects one scenario file");
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
   if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
@@ -118,6 +120,7 @@ int cmd_run(int argc, char** argv) {
   if (auto o = a.option("--out")) opt.output_directory = *o;
   if (auto t = a.option("--threads")) opt.threads = static_cast<int>(parse_count("--threads", *t));
   if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
+  if (auto s = a.option("--time-after")) opt.time_after = static_cast<std::uint64_t>(parse_count("--time-after", *s));
   opt.progress = !a.flag("--quiet");
 
   dp::PluginRegistry registry;

@@ -42,9 +42,12 @@ std::string escape_token(const std::string& key) {
   std::string s;
   s.reserve(key.size());
   for (char c : key) {
-    if (c == '~') s += "~0";
-    else if (c == '/') s += "~1";
-    else s += c;
+    if (c == '~')
+      s += "~0";
+    else if (c == '/')
+      s += "~1";
+    else
+      s += c;
   }
   return s;
 }
@@ -63,11 +66,16 @@ std::string compact(const json& v) {
   return truncate(v.dump(-1, ' ', false, json::error_handler_t::replace));
 }
 
+// A string in JSON double quotes, shortened.
+std::string quoted(const std::string& s) {
+  return json(truncate(s)).dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 // How a found value is shown: numbers, booleans and null as they are,
 // strings quoted with their type named, containers named and abbreviated.
 std::string found_phrase(const json& v) {
   if (v.is_string()) {
-    return "a string (" + json(truncate(v.get_ref<const std::string&>())).dump(-1, ' ', false, json::error_handler_t::replace) + ")";
+    return "a string (" + quoted(v.get_ref<const std::string&>()) + ")";
   }
   if (v.is_object()) return "an object (" + compact(v) + ")";
   if (v.is_array()) return "an array (" + compact(v) + ")";
@@ -242,7 +250,8 @@ struct SchemaValidator::State {
           check_schema(p.value(), kptr + "/" + escape_token(p.key()), seen);
         }
       } else if (k == "required") {
-        if (!val.is_array()) refuse(where + " must be an array of strings, found " + found_phrase(val));
+        if (!val.is_array())
+          refuse(where + " must be an array of strings, found " + found_phrase(val));
         for (const auto& name : val) {
           if (!name.is_string()) {
             refuse(where + " must be an array of strings, found " + found_phrase(name) + " in it");
@@ -285,7 +294,8 @@ struct SchemaValidator::State {
         refs_.emplace(ref, target);
         check_schema(*target, target_ptr, seen);
       } else {
-        std::string msg = "unsupported keyword '" + k + "' in the schema at " + schema_location(ptr);
+        std::string msg =
+            "unsupported keyword '" + k + "' in the schema at " + schema_location(ptr);
         const std::string hint = suggest(k, supported_schema_keywords());
         if (hint.rfind("did you mean", 0) == 0) msg += " (" + hint + ")";
         refuse(msg);
@@ -312,7 +322,8 @@ struct SchemaValidator::State {
 
   // Resolves a local reference "#", "#/a/b~1c" (URI fragment, %-escapes
   // allowed) to a node of root_; target_ptr receives its JSON pointer.
-  const json* resolve(const std::string& ref, const std::string& ptr, std::string& target_ptr) const {
+  const json* resolve(const std::string& ref, const std::string& ptr,
+                      std::string& target_ptr) const {
     const std::string where = "'$ref' \"" + ref + "\" at " + schema_location(ptr);
     if (ref.empty() || ref[0] != '#') {
       refuse(where + ": only local references (\"#\", \"#/$defs/name\", ...) are supported");
@@ -336,7 +347,8 @@ struct SchemaValidator::State {
     std::size_t pos = 1;
     while (true) {
       const std::size_t slash = frag.find('/', pos);
-      const std::string raw = frag.substr(pos, slash == std::string::npos ? std::string::npos : slash - pos);
+      const std::string raw =
+          frag.substr(pos, slash == std::string::npos ? std::string::npos : slash - pos);
       std::string token;
       for (std::size_t i = 0; i < raw.size(); ++i) {
         if (raw[i] != '~') {
@@ -353,8 +365,9 @@ struct SchemaValidator::State {
         if (it == node->end()) refuse(where + " does not resolve: no member '" + token + "'");
         node = &*it;
       } else if (node->is_array()) {
-        const bool digits = !token.empty() && std::all_of(token.begin(), token.end(),
-                                                          [](char c) { return c >= '0' && c <= '9'; });
+        const bool digits = !token.empty() && std::all_of(token.begin(), token.end(), [](char c) {
+          return c >= '0' && c <= '9';
+        });
         if (!digits || (token.size() > 1 && token[0] == '0') || token.size() > 9 ||
             std::stoul(token) >= node->size()) {
           refuse(where + " does not resolve: no element '" + token + "'");
@@ -389,7 +402,8 @@ struct SchemaValidator::State {
     for (const auto& [node, ptr] : seen) visit(node, state, seen);
   }
 
-  void visit(const json* node, std::unordered_map<const json*, int>& state, const Seen& seen) const {
+  void visit(const json* node, std::unordered_map<const json*, int>& state,
+             const Seen& seen) const {
     int& st = state[node];
     if (st == 2) return;
     if (st == 1) {
@@ -417,7 +431,8 @@ struct SchemaValidator::State {
       return fail(out, ptr, "expected " + expected_types(*t) + ", found " + found_phrase(v));
     }
     const std::string* unit = &inherited_unit;
-    if (auto u = s.find("x-unit"); u != s.end() && u->is_string()) unit = &u->get_ref<const std::string&>();
+    if (auto u = s.find("x-unit"); u != s.end() && u->is_string())
+      unit = &u->get_ref<const std::string&>();
 
     bool ok = true;
     // Records a result; true when the caller should stop (first problem, no messages wanted).
@@ -434,19 +449,25 @@ struct SchemaValidator::State {
           list += (i ? ", " : "") + literal((*e)[i]);
           if ((*e)[i].is_string()) names.push_back((*e)[i].get<std::string>());
         }
-        const std::string expected = e->size() == 1 ? list : e->empty() ? "no value (empty enum)" : "one of " + list;
-        const std::string hint = v.is_string() ? suggest(v.get<std::string>(), names) : std::string();
-        if (stop(fail(out, ptr, "expected " + expected + ", found " + found_literal(v), hint))) return false;
+        const std::string expected = e->size() == 1 ? list
+                                     : e->empty()   ? "no value (empty enum)"
+                                                    : "one of " + list;
+        const std::string hint =
+            v.is_string() ? suggest(v.get<std::string>(), names) : std::string();
+        if (stop(fail(out, ptr, "expected " + expected + ", found " + found_literal(v), hint)))
+          return false;
       }
     }
     if (auto c = s.find("const"); c != s.end() && *c != v) {
-      if (stop(fail(out, ptr, "expected " + literal(*c) + ", found " + found_literal(v)))) return false;
+      if (stop(fail(out, ptr, "expected " + literal(*c) + ", found " + found_literal(v))))
+        return false;
     }
 
     if (v.is_number()) {
       const auto t = s.find("type");
-      const bool integer = t != s.end() && ((t->is_string() && *t == "integer") ||
-                                            (t->is_array() && t->size() == 1 && (*t)[0] == "integer"));
+      const bool integer =
+          t != s.end() && ((t->is_string() && *t == "integer") ||
+                           (t->is_array() && t->size() == 1 && (*t)[0] == "integer"));
       struct Bound {
         const char* keyword;
         const char* op;
@@ -461,8 +482,8 @@ struct SchemaValidator::State {
       for (const auto& b : bounds) {
         auto it = s.find(b.keyword);
         if (it == s.end() || b.holds(compare_numbers(v, *it))) continue;
-        std::string msg = std::string("expected ") + (integer ? "an integer " : "a number ") + b.op + " " +
-                          compact(*it);
+        std::string msg = std::string("expected ") + (integer ? "an integer " : "a number ") +
+                          b.op + " " + compact(*it);
         // "1" marks a dimensionless quantity: "[1]" would only confuse.
         if (!unit->empty() && *unit != "1") msg += " [" + *unit + "]";
         if (stop(fail(out, ptr, msg + ", found " + compact(v)))) return false;
@@ -473,7 +494,7 @@ struct SchemaValidator::State {
       const std::size_t n = code_points(v.get_ref<const std::string&>());
       const auto lo = s.find("minLength"), hi = s.find("maxLength");
       const bool exact = lo != s.end() && hi != s.end() && as_size(*lo) == as_size(*hi);
-      const std::string shown = json(truncate(v.get_ref<const std::string&>())).dump(-1, ' ', false, json::error_handler_t::replace);
+      const std::string shown = quoted(v.get_ref<const std::string&>());
       auto length_error = [&](const char* relation, std::size_t limit) {
         if (exact) {
           return "expected a string of exactly " + plural(limit, "character") + ", found " +
@@ -496,10 +517,11 @@ struct SchemaValidator::State {
       const bool exact = lo != s.end() && hi != s.end() && as_size(*lo) == as_size(*hi);
       auto count_error = [&](const char* relation, std::size_t limit) {
         if (exact) {
-          return "expected an array of exactly " + plural(limit, "item") + ", found " + std::to_string(n);
+          return "expected an array of exactly " + plural(limit, "item") + ", found " +
+                 std::to_string(n);
         }
-        return std::string("expected an array of ") + relation + " " + plural(limit, "item") + ", found " +
-               plural(n, "item");
+        return std::string("expected an array of ") + relation + " " + plural(limit, "item") +
+               ", found " + plural(n, "item");
       };
       if (lo != s.end() && n < as_size(*lo)) {
         if (stop(fail(out, ptr, count_error("at least", as_size(*lo))))) return false;
@@ -509,7 +531,8 @@ struct SchemaValidator::State {
       }
       if (auto items = s.find("items"); items != s.end()) {
         for (std::size_t i = 0; i < n; ++i) {
-          if (stop(eval(*items, v[i], ptr + "/" + std::to_string(i), std::string(), out))) return false;
+          if (stop(eval(*items, v[i], ptr + "/" + std::to_string(i), std::string(), out)))
+            return false;
         }
       }
     }
@@ -545,7 +568,8 @@ struct SchemaValidator::State {
           if (props != s.end()) {
             for (auto p = props->begin(); p != props->end(); ++p) names.push_back(p.key());
           }
-          if (stop(fail(out, child, "unknown property '" + it.key() + "'", suggest(it.key(), names)))) {
+          if (stop(fail(out, child, "unknown property '" + it.key() + "'",
+                        suggest(it.key(), names)))) {
             return false;
           }
         } else if (stop(eval(*extra, it.value(), child, std::string(), out))) {
@@ -569,8 +593,9 @@ struct SchemaValidator::State {
       if (stop(eval_alternatives(*one, true, v, ptr, *unit, out))) return false;
     }
     if (auto n = s.find("not"); n != s.end() && eval(*n, v, ptr, *unit, nullptr)) {
-      if (stop(fail(out, ptr, "expected a value that does not match the excluded form, found " +
-                                  found_phrase(v)))) {
+      if (stop(fail(out, ptr,
+                    "expected a value that does not match the excluded form, found " +
+                        found_phrase(v)))) {
         return false;
       }
     }
@@ -578,8 +603,9 @@ struct SchemaValidator::State {
   }
 
   // anyOf (exactly_one false) or oneOf (exactly_one true).
-  bool eval_alternatives(const json& branches, bool exactly_one, const json& v, const std::string& ptr,
-                         const std::string& unit, std::vector<Diagnostic>* out) const {
+  bool eval_alternatives(const json& branches, bool exactly_one, const json& v,
+                         const std::string& ptr, const std::string& unit,
+                         std::vector<Diagnostic>* out) const {
     const std::size_t n = branches.size();
     if (out == nullptr) {
       std::size_t matches = 0;
@@ -599,8 +625,10 @@ struct SchemaValidator::State {
     if (matching.size() == 1) return true;
     if (matching.size() > 1) {
       std::string which;
-      for (std::size_t i = 0; i < matching.size(); ++i) which += (i ? ", " : "") + std::to_string(matching[i] + 1);
-      return fail(out, ptr, "matches more than one of the allowed forms", "matching forms: " + which);
+      for (std::size_t i = 0; i < matching.size(); ++i)
+        which += (i ? ", " : "") + std::to_string(matching[i] + 1);
+      return fail(out, ptr, "matches more than one of the allowed forms",
+                  "matching forms: " + which);
     }
     report_no_match(branches, v, ptr, errors, *out);
     return false;
@@ -610,7 +638,8 @@ struct SchemaValidator::State {
   // meant (the only one declaring the instance's type, else the only one with
   // the fewest errors), or a summary when none stands out.
   void report_no_match(const json& branches, const json& v, const std::string& ptr,
-                       const std::vector<std::vector<Diagnostic>>& errors, std::vector<Diagnostic>& out) const {
+                       const std::vector<std::vector<Diagnostic>>& errors,
+                       std::vector<Diagnostic>& out) const {
     const std::size_t n = branches.size();
     std::vector<std::size_t> declared_match, compatible, all;
     for (std::size_t i = 0; i < n; ++i) {
@@ -618,14 +647,17 @@ struct SchemaValidator::State {
       const auto types = declared_types(branches[i], 0);
       if (types.empty()) {
         compatible.push_back(i);
-      } else if (std::any_of(types.begin(), types.end(), [&](const std::string& t) { return type_matches(t, v); })) {
+      } else if (std::any_of(types.begin(), types.end(),
+                             [&](const std::string& t) { return type_matches(t, v); })) {
         declared_match.push_back(i);
         compatible.push_back(i);
       }
     }
     auto take = [&](std::size_t i) { out.insert(out.end(), errors[i].begin(), errors[i].end()); };
     if (declared_match.size() == 1) return take(declared_match[0]);
-    const auto& pool = !declared_match.empty() ? declared_match : !compatible.empty() ? compatible : all;
+    const auto& pool = !declared_match.empty() ? declared_match
+                       : !compatible.empty()   ? compatible
+                                               : all;
     std::size_t best = pool[0], ties = 0;
     for (std::size_t i : pool) {
       if (errors[i].size() < errors[best].size()) {
@@ -644,7 +676,8 @@ struct SchemaValidator::State {
       if (!hint.empty()) hint += "; ";
       hint += "form " + std::to_string(i + 1) + ": ";
       if (d.pointer != ptr) {
-        hint += "at " + (d.pointer.rfind(ptr, 0) == 0 ? d.pointer.substr(ptr.size()) : d.pointer) + ": ";
+        hint += "at " + (d.pointer.rfind(ptr, 0) == 0 ? d.pointer.substr(ptr.size()) : d.pointer) +
+                ": ";
       }
       hint += d.message;
     }
@@ -658,8 +691,10 @@ struct SchemaValidator::State {
     std::vector<std::string> types;
     if (!s.is_object() || depth > 32) return types;
     if (auto t = s.find("type"); t != s.end()) {
-      if (t->is_string()) types.push_back(t->get<std::string>());
-      else for (const auto& x : *t) types.push_back(x.get<std::string>());
+      if (t->is_string())
+        types.push_back(t->get<std::string>());
+      else
+        for (const auto& x : *t) types.push_back(x.get<std::string>());
     } else if (auto c = s.find("const"); c != s.end()) {
       types.push_back(json_type_name(*c));
     } else if (auto e = s.find("enum"); e != s.end()) {
@@ -674,7 +709,8 @@ struct SchemaValidator::State {
   std::string description_of(const json& s) const {
     const json* node = &s;
     for (int depth = 0; depth < 32 && node->is_object(); ++depth) {
-      if (auto d = node->find("description"); d != node->end() && d->is_string()) return d->get<std::string>();
+      if (auto d = node->find("description"); d != node->end() && d->is_string())
+        return d->get<std::string>();
       auto r = node->find("$ref");
       if (r == node->end()) break;
       node = refs_.at(r->get_ref<const std::string&>());
@@ -712,12 +748,35 @@ const nlohmann::json& SchemaValidator::schema() const { return state_->root_; }
 
 const std::vector<std::string>& supported_schema_keywords() {
   static const std::vector<std::string> keywords = [] {
-    std::vector<std::string> k = {
-        "type",     "properties", "required",  "additionalProperties", "enum",      "const",
-        "minimum",  "maximum",    "exclusiveMinimum", "exclusiveMaximum", "minItems", "maxItems",
-        "items",    "minLength",  "maxLength", "oneOf",                "anyOf",     "allOf",
-        "not",      "$ref",       "$defs",     "definitions",          "$schema",   "$id",
-        "title",    "description", "default",  "examples",             "$comment"};
+    std::vector<std::string> k = {"type",
+                                  "properties",
+                                  "required",
+                                  "additionalProperties",
+                                  "enum",
+                                  "const",
+                                  "minimum",
+                                  "maximum",
+                                  "exclusiveMinimum",
+                                  "exclusiveMaximum",
+                                  "minItems",
+                                  "maxItems",
+                                  "items",
+                                  "minLength",
+                                  "maxLength",
+                                  "oneOf",
+                                  "anyOf",
+                                  "allOf",
+                                  "not",
+                                  "$ref",
+                                  "$defs",
+                                  "definitions",
+                                  "$schema",
+                                  "$id",
+                                  "title",
+                                  "description",
+                                  "default",
+                                  "examples",
+                                  "$comment"};
     std::sort(k.begin(), k.end());
     return k;
   }();

@@ -26,8 +26,9 @@ namespace domel::platform {
 /// schemas. Ignored: $schema, $id (root only), title, description, default,
 /// examples, $comment and every keyword starting with "x-" ("x-unit" is shown
 /// in bound messages unless it is "1", dimensionless; a unit on a schema is
-/// inherited through its $ref/allOf/anyOf/oneOf/not). A cycle of $ref / allOf / anyOf / oneOf / not that never
-/// descends into the instance is refused as malformed.
+/// inherited through its $ref/allOf/anyOf/oneOf/not). A cycle of $ref, allOf,
+/// anyOf, oneOf or not that never descends into the instance is refused as
+/// malformed.
 ///
 /// Copies share the (immutable) checked schema; validate() is const and may be
 /// called from several threads at once.

@@ -105,6 +105,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   auto last_report = start;
   const bool tty = isatty(fileno(stderr));
   double particle_steps = 0;
+  double window_particle_steps = 0;
+  auto window_start = start;
   std::uint64_t m = 0;
   const std::uint64_t stop = options.max_steps ? std::min(options.max_steps, total_macro) : total_macro;
   for (;; ++m) {
@@ -118,9 +120,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       next_vtk += vtk_interval;
     }
     if (m == stop) break;
+    if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
       for (int s = 0; s < substeps[k]; ++s) subdomains[k]->step();
-      particle_steps += static_cast<double>(substeps[k]) * subdomains[k]->store().size();
+      const double ps = static_cast<double>(substeps[k]) * subdomains[k]->store().size();
+      particle_steps += ps;
+      if (options.time_after && m >= options.time_after) window_particle_steps += ps;
     }
     const auto now = std::chrono::steady_clock::now();
     const double since = std::chrono::duration<double>(now - last_report).count();
@@ -135,7 +140,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       std::fflush(stderr);
     }
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto end = std::chrono::steady_clock::now();
+  const double wall = std::chrono::duration<double>(end - start).count();
   if (options.progress && tty) std::fprintf(stderr, "\n");
   if (probes) probes->flush();
 
@@ -184,6 +190,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                               {"wall_contacts", st.wall_contacts}}}});
   }
   summary["subdomains"] = sds;
+  if (options.time_after && m > options.time_after) {
+    const double w = std::chrono::duration<double>(end - window_start).count();
+    summary["timed_window"] = {{"from_step", options.time_after},
+                               {"steps", m - options.time_after},
+                               {"wall_time_s", w},
+                               {"particle_steps_per_s", w > 0 ? window_particle_steps / w : 0.0}};
+  }
   nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
   summary["outputs"] = files;
   io::write_file_atomically(out / "summary.json", summary.dump(2) + "\n");

@@ -24,6 +24,7 @@ struct RunOptions {
   int threads = 0;                         ///< 0: the scenario's choice
   bool progress = true;
   std::uint64_t max_steps = 0;             ///< 0: run to the end; otherwise stop early (smoke tests)
+  std::uint64_t time_after = 0;            ///< benchmarks: also time the steps after this many (warm-up excluded)
 };
 
 struct RunResult {

@@ -69,9 +69,14 @@ TEST(RestitutionHertz, ParticleParticleAndWallWithin1Percent) {
 }
 
 TEST(RestitutionLinear, ParticleParticleAndWallWithin1Percent) {
+  // The unclamped linear dashpot still pulls with ~eta*v when the overlap
+  // reaches zero, so where the contact ends inside a step shifts the
+  // rebound speed by up to ~2 zeta omega dt (first order in dt; ~1 % at
+  // t_c/200 for e = 0.3, measured 0.27 % at t_c/800). Hertz damping vanishes
+  // with sqrt(delta) and has no such jump. Hence t_c/1000 here.
   for (double e : {0.3, 0.5, 0.9})
     for (bool wall : {false, true}) {
-      const Outcome o = collide(dt::linear_spring(500.0), e, wall);
+      const Outcome o = collide(dt::linear_spring(500.0), e, wall, 1.0, 1000);
       EXPECT_NEAR(o.restitution, e, 0.01 * e) << "e = " << e << (wall ? " wall" : " pair");
     }
 }

@@ -8,6 +8,7 @@
 // is checked by json_schema_suite_test.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -26,7 +27,8 @@ using domel::platform::suggest;
 using domel::platform::supported_schema_keywords;
 using nlohmann::json;
 
-std::vector<Diagnostic> check(const json& schema, const json& instance, const std::string& base = "") {
+std::vector<Diagnostic> check(const json& schema, const json& instance,
+                              const std::string& base = "") {
   std::vector<Diagnostic> out;
   const SchemaValidator validator(schema);
   validator.validate(instance, out, base);
@@ -67,7 +69,8 @@ TEST(JsonSchema, MissingRequiredNamesPropertyAndDescription) {
   EXPECT_EQ(d[0].file, "");
 }
 
-// Guards that a property without description gets the bare message, and that $ref is followed for it.
+// Guards that a property without description gets the bare message, and that $ref is followed for
+// it.
 TEST(JsonSchema, MissingRequiredWithoutOrBehindRefDescription) {
   const auto bare = check(kMaterial, json{{"density", 1}});
   ASSERT_EQ(bare.size(), 1u);
@@ -84,7 +87,8 @@ TEST(JsonSchema, MissingRequiredWithoutOrBehindRefDescription) {
 
 // Guards additionalProperties:false: pointer of the unknown key, message and did-you-mean hint.
 TEST(JsonSchema, UnknownPropertyWithDidYouMean) {
-  const auto d = check(kMaterial, json{{"density", 1}, {"youngs_modulus", 1}, {"densty", 2}}, "/materials/a");
+  const auto d =
+      check(kMaterial, json{{"density", 1}, {"youngs_modulus", 1}, {"densty", 2}}, "/materials/a");
   ASSERT_EQ(d.size(), 1u);
   EXPECT_EQ(d[0].pointer, "/materials/a/densty");
   EXPECT_EQ(d[0].message, "unknown property 'densty'");
@@ -106,7 +110,8 @@ TEST(JsonSchema, AdditionalPropertiesSchema) {
 
 // Guards the type message: expected type, found value shown compactly with strings quoted.
 TEST(JsonSchema, TypeMismatchShowsFoundValue) {
-  EXPECT_EQ(check({{"type", "number"}}, "abc").at(0).message, "expected a number, found a string (\"abc\")");
+  EXPECT_EQ(check({{"type", "number"}}, "abc").at(0).message,
+            "expected a number, found a string (\"abc\")");
   EXPECT_EQ(check({{"type", "string"}}, true).at(0).message, "expected a string, found true");
   EXPECT_EQ(check({{"type", "string"}}, nullptr).at(0).message, "expected a string, found null");
   EXPECT_EQ(check({{"type", "object"}}, json::array({1, 2})).at(0).message,
@@ -147,12 +152,14 @@ TEST(JsonSchema, NumericBoundMessages) {
   EXPECT_EQ(check({{"exclusiveMinimum", 0}}, -3).at(0).message, "expected a number > 0, found -3");
   EXPECT_EQ(check({{"minimum", 0}}, -0.5).at(0).message, "expected a number >= 0, found -0.5");
   EXPECT_EQ(check({{"maximum", 1}}, 2).at(0).message, "expected a number <= 1, found 2");
-  EXPECT_EQ(check({{"exclusiveMaximum", 90}}, 90).at(0).message, "expected a number < 90, found 90");
+  EXPECT_EQ(check({{"exclusiveMaximum", 90}}, 90).at(0).message,
+            "expected a number < 90, found 90");
   EXPECT_TRUE(check({{"minimum", 0}}, 0).empty());
   EXPECT_TRUE(check({{"maximum", 1}}, 1.0).empty());
   EXPECT_EQ(check({{"exclusiveMinimum", 0}}, 0).size(), 1u);
   // An integer schema says so; bounds ignore non-numbers.
-  EXPECT_EQ(check({{"type", "integer"}, {"minimum", 1}}, 0).at(0).message, "expected an integer >= 1, found 0");
+  EXPECT_EQ(check({{"type", "integer"}, {"minimum", 1}}, 0).at(0).message,
+            "expected an integer >= 1, found 0");
   EXPECT_TRUE(check({{"minimum", 1}}, "text").empty());
 }
 
@@ -168,7 +175,8 @@ TEST(JsonSchema, BoundMessagesShowUnit) {
   })");
   EXPECT_EQ(check(schema, json{{"radius", 0}}).at(0).message, "expected a number > 0 [m], found 0");
   // "1" (dimensionless) is not shown.
-  EXPECT_EQ(check({{"maximum", 1}, {"x-unit", "1"}}, 1.5).at(0).message, "expected a number <= 1, found 1.5");
+  EXPECT_EQ(check({{"maximum", 1}, {"x-unit", "1"}}, 1.5).at(0).message,
+            "expected a number <= 1, found 1.5");
 }
 
 // Guards enum: the allowed values listed, the found one quoted, did-you-mean for strings.
@@ -198,8 +206,10 @@ TEST(JsonSchema, ConstMessage) {
 
 // Guards array-size messages: at least / at most / exactly (3-vectors), with singular and plural.
 TEST(JsonSchema, ItemCountMessages) {
-  const json vec3 = {{"type", "array"}, {"items", {{"type", "number"}}}, {"minItems", 3}, {"maxItems", 3}};
-  EXPECT_EQ(check(vec3, json::array({1, 2})).at(0).message, "expected an array of exactly 3 items, found 2");
+  const json vec3 = {
+      {"type", "array"}, {"items", {{"type", "number"}}}, {"minItems", 3}, {"maxItems", 3}};
+  EXPECT_EQ(check(vec3, json::array({1, 2})).at(0).message,
+            "expected an array of exactly 3 items, found 2");
   EXPECT_EQ(check(vec3, json::array({1, 2, 3, 4})).at(0).message,
             "expected an array of exactly 3 items, found 4");
   EXPECT_EQ(check({{"minItems", 3}}, json::array({1, 2})).at(0).message,
@@ -219,8 +229,8 @@ TEST(JsonSchema, StringLengthCountsCodePoints) {
             "expected a string of at most 2 characters, found 3 characters (\"abc\")");
   EXPECT_EQ(check({{"minLength", 2}, {"maxLength", 2}}, "a").at(0).message,
             "expected a string of exactly 2 characters, found 1 (\"a\")");
-  EXPECT_TRUE(check({{"maxLength", 2}}, "\u00e9\u00e9").empty());          // 4 bytes, 2 code points
-  EXPECT_TRUE(check({{"maxLength", 1}}, "\xF0\x9F\x92\xA9").empty());      // one 4-byte code point
+  EXPECT_TRUE(check({{"maxLength", 2}}, "\u00e9\u00e9").empty());      // 4 bytes, 2 code points
+  EXPECT_TRUE(check({{"maxLength", 1}}, "\xF0\x9F\x92\xA9").empty());  // one 4-byte code point
   EXPECT_EQ(check({{"minLength", 2}}, "\xF0\x9F\x92\xA9").size(), 1u);
 }
 
@@ -252,8 +262,9 @@ TEST(JsonSchema, OneOfWithoutClearBranch) {
   ASSERT_EQ(none.size(), 1u);
   EXPECT_EQ(none[0].pointer, "/run");
   EXPECT_EQ(none[0].message, "does not match any of the allowed forms");
-  EXPECT_EQ(none[0].hint,
-            "form 1: missing required property 'duration'; form 2: missing required property 'steps'");
+  EXPECT_EQ(
+      none[0].hint,
+      "form 1: missing required property 'duration'; form 2: missing required property 'steps'");
 }
 
 // Guards oneOf matched by several branches.
@@ -301,10 +312,13 @@ TEST(JsonSchema, NotAndFalseSchema) {
 
 // Guards RFC 6901 escaping of keys ("/" -> "~1", "~" -> "~0"), array indices and the base pointer.
 TEST(JsonSchema, PointerEscaping) {
-  const json schema = {{"properties", {{"a/b", {{"type", "string"}}}, {"m~n", {{"type", "string"}}},
-                                       {"list", {{"items", {{"type", "string"}}}}}}},
+  const json schema = {{"properties",
+                        {{"a/b", {{"type", "string"}}},
+                         {"m~n", {{"type", "string"}}},
+                         {"list", {{"items", {{"type", "string"}}}}}}},
                        {"additionalProperties", false}};
-  const auto d = check(schema, json{{"a/b", 1}, {"m~n", 2}, {"list", {"x", 3}}, {"x/~y", 0}}, "/subdomains/0");
+  const auto d =
+      check(schema, json{{"a/b", 1}, {"m~n", 2}, {"list", {"x", 3}}, {"x/~y", 0}}, "/subdomains/0");
   ASSERT_EQ(d.size(), 4u);
   std::vector<std::string> pointers;
   for (const auto& x : d) pointers.push_back(x.pointer);
@@ -314,7 +328,8 @@ TEST(JsonSchema, PointerEscaping) {
 
 // Guards that every problem is collected in one pass, not only the first.
 TEST(JsonSchema, CollectsAllErrors) {
-  const auto d = check(kMaterial, json{{"densty", 1}, {"youngs_modulus", -3}, {"poisson_ratio", "x"}});
+  const auto d =
+      check(kMaterial, json{{"densty", 1}, {"youngs_modulus", -3}, {"poisson_ratio", "x"}});
   ASSERT_EQ(d.size(), 4u);
   auto has = [&](const std::string& pointer, const std::string& message) {
     for (const auto& x : d) {
@@ -336,7 +351,8 @@ TEST(JsonSchema, WrongTypeSuppressesChildErrors) {
   EXPECT_EQ(d[0].pointer, "/material");
   EXPECT_EQ(d[0].message, "expected an object, found an array ([1])");
   // Also with oneOf next to the type: no "matches more than one" noise.
-  const json region = {{"type", "object"}, {"oneOf", {{{"required", {"box"}}}, {{"required", {"cylinder"}}}}}};
+  const json region = {{"type", "object"},
+                       {"oneOf", {{{"required", {"box"}}}, {{"required", {"cylinder"}}}}}};
   EXPECT_EQ(check(region, 5).size(), 1u);
 }
 
@@ -353,14 +369,19 @@ TEST(JsonSchema, LocalRefs) {
       "child": { "$ref": "#" }
     }
   })");
-  EXPECT_TRUE(check(schema, json{{"gravity", {0, 0, -9.81}}, {"n", 1}, {"s", "x"}, {"b", true}, {"name", "a"}}).empty());
-  const auto d = check(schema, json{{"gravity", {0, 0, "z"}}, {"n", 1.5}, {"s", 1}, {"b", 0}, {"name", ""}});
+  EXPECT_TRUE(
+      check(schema,
+            json{{"gravity", {0, 0, -9.81}}, {"n", 1}, {"s", "x"}, {"b", true}, {"name", "a"}})
+          .empty());
+  const auto d =
+      check(schema, json{{"gravity", {0, 0, "z"}}, {"n", 1.5}, {"s", 1}, {"b", 0}, {"name", ""}});
   ASSERT_EQ(d.size(), 5u);
   EXPECT_EQ(d[0].pointer, "/b");
   EXPECT_EQ(d[1].pointer, "/gravity/2");
   EXPECT_EQ(d[1].message, "expected a number, found a string (\"z\")");
   EXPECT_EQ(d[2].message, "expected an integer, found 1.5");
-  EXPECT_EQ(check(schema, json{{"gravity", {0, 0}}}).at(0).message, "expected an array of exactly 3 items, found 2");
+  EXPECT_EQ(check(schema, json{{"gravity", {0, 0}}}).at(0).message,
+            "expected an array of exactly 3 items, found 2");
   const auto nested = check(schema, json{{"child", {{"child", {{"n", "x"}}}}}});
   ASSERT_EQ(nested.size(), 1u);
   EXPECT_EQ(nested[0].pointer, "/child/child/n");
@@ -378,7 +399,8 @@ TEST(JsonSchema, IgnoresAnnotationsAndExtensions) {
   EXPECT_EQ(check({{"type", "string"}, {"x-unit", "m"}}, "abc").size(), 0u);
 }
 
-// Guards that an unsupported keyword is refused by the constructor, naming it and its schema pointer.
+// Guards that an unsupported keyword is refused by the constructor, naming it and its schema
+// pointer.
 TEST(JsonSchema, RejectsUnsupportedKeyword) {
   const json schema = {{"properties", {{"a", {{"patternProperties", {{"^x", json::object()}}}}}}}};
   EXPECT_THROW(SchemaValidator{schema}, std::invalid_argument);
@@ -388,37 +410,40 @@ TEST(JsonSchema, RejectsUnsupportedKeyword) {
   const std::string typo = construction_error({{"minimun", 0}});
   EXPECT_NE(typo.find("did you mean 'minimum'?"), std::string::npos) << typo;
   // Unsupported also deep inside $defs that nothing refers to.
-  EXPECT_NE(construction_error({{"$defs", {{"x", {{"if", true}}}}}}).find("'if' in the schema at #/$defs/x"),
+  EXPECT_NE(construction_error({{"$defs", {{"x", {{"if", true}}}}}})
+                .find("'if' in the schema at #/$defs/x"),
             std::string::npos);
 }
 
 // Guards that malformed schemas and unsupported forms are refused at construction.
 TEST(JsonSchema, RejectsMalformedSchemas) {
   const std::vector<json> bad = {
-      42,                                                     // not a schema
-      {{"type", "float"}},                                    // unknown type
-      {{"type", json::array()}},                              // empty type list
-      {{"minimum", "3"}},                                     // bound not a number
-      {{"exclusiveMinimum", true}},                           // draft-4 boolean form
-      {{"minItems", -1}},                                     // negative count
-      {{"minLength", 1.5}},                                   // fractional count
-      {{"required", "a"}},                                    // not an array
-      {{"anyOf", json::array()}},                             // empty
-      {{"items", {json::object()}}},                          // array form of items
-      {{"properties", {{"a", 3}}}},                           // property schema not a schema
-      {{"$ref", "other.json#/a"}},                            // remote ref
-      {{"$ref", "#/$defs/missing"}},                          // unresolvable ref
-      {{"$ref", "#anchor"}},                                  // plain-name fragment
-      {{"$defs", {{"a", {{"$id", "x"}}}}}},                   // $id below the root
-      {{"$ref", "#"}},                                        // endless self reference
-      {{"allOf", {{{"$ref", "#"}}}}},                         // endless through allOf
-      json::parse(R"({"$defs": {"a": {"$ref": "#/$defs/b"}, "b": {"not": {"$ref": "#/$defs/a"}}}})"),
+      42,                                    // not a schema
+      {{"type", "float"}},                   // unknown type
+      {{"type", json::array()}},             // empty type list
+      {{"minimum", "3"}},                    // bound not a number
+      {{"exclusiveMinimum", true}},          // draft-4 boolean form
+      {{"minItems", -1}},                    // negative count
+      {{"minLength", 1.5}},                  // fractional count
+      {{"required", "a"}},                   // not an array
+      {{"anyOf", json::array()}},            // empty
+      {{"items", {json::object()}}},         // array form of items
+      {{"properties", {{"a", 3}}}},          // property schema not a schema
+      {{"$ref", "other.json#/a"}},           // remote ref
+      {{"$ref", "#/$defs/missing"}},         // unresolvable ref
+      {{"$ref", "#anchor"}},                 // plain-name fragment
+      {{"$defs", {{"a", {{"$id", "x"}}}}}},  // $id below the root
+      {{"$ref", "#"}},                       // endless self reference
+      {{"allOf", {{{"$ref", "#"}}}}},        // endless through allOf
+      json::parse(
+          R"({"$defs": {"a": {"$ref": "#/$defs/b"}, "b": {"not": {"$ref": "#/$defs/a"}}}})"),
   };
   for (const auto& schema : bad) {
     EXPECT_THROW(SchemaValidator{schema}, std::invalid_argument) << schema.dump();
   }
   EXPECT_NE(construction_error({{"type", "float"}}).find("'float'"), std::string::npos);
-  EXPECT_NE(construction_error({{"$ref", "other.json#/a"}}).find("only local references"), std::string::npos);
+  EXPECT_NE(construction_error({{"$ref", "other.json#/a"}}).find("only local references"),
+            std::string::npos);
   // Recursion that descends into the instance is fine.
   EXPECT_EQ(construction_error({{"properties", {{"next", {{"$ref", "#"}}}}}}), "");
 }
@@ -427,9 +452,27 @@ TEST(JsonSchema, RejectsMalformedSchemas) {
 TEST(JsonSchema, SupportedKeywordList) {
   const auto& k = supported_schema_keywords();
   EXPECT_TRUE(std::is_sorted(k.begin(), k.end()));
-  for (const char* name : {"type", "properties", "required", "additionalProperties", "enum", "const", "minimum",
-                           "maximum", "exclusiveMinimum", "exclusiveMaximum", "minItems", "maxItems", "items",
-                           "minLength", "maxLength", "oneOf", "anyOf", "allOf", "not", "$ref", "$defs"}) {
+  for (const char* name : {"type",
+                           "properties",
+                           "required",
+                           "additionalProperties",
+                           "enum",
+                           "const",
+                           "minimum",
+                           "maximum",
+                           "exclusiveMinimum",
+                           "exclusiveMaximum",
+                           "minItems",
+                           "maxItems",
+                           "items",
+                           "minLength",
+                           "maxLength",
+                           "oneOf",
+                           "anyOf",
+                           "allOf",
+                           "not",
+                           "$ref",
+                           "$defs"}) {
     EXPECT_NE(std::find(k.begin(), k.end(), name), k.end()) << name;
   }
   EXPECT_EQ(std::find(k.begin(), k.end(), "patternProperties"), k.end());
@@ -448,7 +491,8 @@ TEST(JsonSchema, SupportedKeywordList) {
   EXPECT_TRUE(SchemaValidator(schema).is_valid(json::object()));
 }
 
-// Guards that schema() returns the given schema and that copies stay usable after the original is gone.
+// Guards that schema() returns the given schema and that copies stay usable after the original is
+// gone.
 TEST(JsonSchema, CopiesShareTheCheckedSchema) {
   const json schema = {{"$defs", {{"p", {{"minimum", 0}}}}}, {"$ref", "#/$defs/p"}};
   std::vector<SchemaValidator> copies;
