@@ -531,8 +531,12 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
           domel_insert_request_v1 req{};
           req.struct_size = sizeof(req);
           req.region = make_region(block["region"]);
+          // Derived from the run seed, the subdomain's name and the inserter's
+          // position, so adding or removing another subdomain changes nothing here.
+          std::uint64_t name_hash = 1469598103934665603ull;  // FNV-1a
+          for (unsigned char ch : sd_name) name_hash = (name_hash ^ ch) * 1099511628211ull;
           req.seed = block.contains("seed") ? block["seed"].get<std::uint64_t>()
-                                            : sim->seed * 1000003ull + k * 1009ull + q;
+                                            : sim->seed * 1000003ull + name_hash + q;
           req.length_scale = alpha;
           req.n_existing = st.size();
           req.ex_x = st.x.data(); req.ex_y = st.y.data(); req.ex_z = st.z.data(); req.ex_r = st.radius.data();

@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: MIT
+// Guards the Verlet list (platform/core/neighbor_list.cpp): it finds exactly
+// the pairs within r_i + r_j + skin (checked against brute force on a
+// polydisperse random cloud), orients every pair id_i < id_j, rebuilds when
+// a particle moved more than half the skin, and carries contact history by
+// pair ids across rebuilds and re-ordering of the store.
+#include "core/neighbor_list.hpp"
+#include "core/error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+using namespace domel::platform;
+
+namespace {
+
+ParticleStore cloud(std::size_t n, unsigned seed) {
+  ParticleStore s;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(0.0, 0.05), rad(0.001, 0.003);
+  for (std::size_t k = 0; k < n; ++k) s.add(100 + k, pos(rng), pos(rng), pos(rng), rad(rng), 2500);
+  return s;
+}
+
+std::set<std::pair<std::uint64_t, std::uint64_t>> brute(const ParticleStore& s, double skin) {
+  std::set<std::pair<std::uint64_t, std::uint64_t>> out;
+  for (std::size_t a = 0; a < s.size(); ++a)
+    for (std::size_t b = a + 1; b < s.size(); ++b) {
+      const double dx = s.x[a] - s.x[b], dy = s.y[a] - s.y[b], dz = s.z[a] - s.z[b];
+      const double cut = s.radius[a] + s.radius[b] + skin;
+      if (dx * dx + dy * dy + dz * dz < cut * cut) out.insert(std::minmax(s.id[a], s.id[b]));
+    }
+  return out;
+}
+
+}  // namespace
+
+TEST(NeighborList, FindsExactlyThePairsWithinCutoffOrientedByIds) {
+  const ParticleStore s = cloud(800, 7);
+  NeighborList nl;
+  nl.configure(0.0008, 3);
+  nl.build(s);
+  std::set<std::pair<std::uint64_t, std::uint64_t>> found;
+  for (std::size_t k = 0; k < nl.size(); ++k) {
+    EXPECT_LT(s.id[nl.i[k]], s.id[nl.j[k]]);
+    EXPECT_TRUE(found.insert({s.id[nl.i[k]], s.id[nl.j[k]]}).second) << "pair listed twice";
+  }
+  EXPECT_EQ(found, brute(s, 0.0008));
+  EXPECT_GT(found.size(), 100u);
+}
+
+TEST(NeighborList, RebuildsOnlyAfterHalfSkinDisplacement) {
+  ParticleStore s = cloud(50, 3);
+  NeighborList nl;
+  nl.configure(0.001, 0);
+  nl.build(s);
+  EXPECT_FALSE(nl.needs_rebuild(s));
+  s.x[10] += 0.00049;
+  EXPECT_FALSE(nl.needs_rebuild(s));
+  s.x[10] += 0.00002;  // now 0.51 mm > skin/2
+  EXPECT_TRUE(nl.needs_rebuild(s));
+}
+
+TEST(NeighborList, HistorySurvivesRebuildAndReordering) {
+  ParticleStore s = cloud(400, 11);
+  NeighborList nl;
+  nl.configure(0.0008, 3);
+  nl.build(s);
+  // mark every other pair as touching with a history that encodes its ids
+  std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
+  for (std::size_t k = 0; k < nl.size(); k += 2) {
+    const double tag = static_cast<double>(s.id[nl.i[k]] * 10000 + s.id[nl.j[k]]);
+    nl.touching[k] = 1;
+    for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
+    expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
+  }
+  // reverse the store order, as a space-filling-curve sort would shuffle it
+  std::vector<std::uint32_t> order(s.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(order.size() - 1 - k);
+  s.permute(order);
+  ASSERT_TRUE(nl.needs_rebuild(s));
+  nl.build(s);
+  std::size_t carried = 0;
+  for (std::size_t k = 0; k < nl.size(); ++k) {
+    const auto key = std::make_pair(s.id[nl.i[k]], s.id[nl.j[k]]);
+    auto it = expected.find(key);
+    if (it == expected.end()) {
+      EXPECT_EQ(nl.touching[k], 0);
+      EXPECT_EQ(nl.history[k * 3], 0.0);
+      continue;
+    }
+    ++carried;
+    EXPECT_EQ(nl.touching[k], 1);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(nl.history[k * 3 + c], it->second + c);
+  }
+  EXPECT_EQ(carried, expected.size());
+}
+
+TEST(WallNeighbors, HistoryFollowsParticleIdsAcrossReordering) {
+  ParticleStore s = cloud(200, 5);
+  WallPrimitive floor;
+  floor.p[2] = 0.01;  // plane z = 0.01, normal +z
+  WallNeighbors wl;
+  wl.build(s, floor, 0.002, 3);
+  ASSERT_FALSE(wl.particle.empty());
+  for (std::size_t k = 0; k < wl.particle.size(); ++k) {
+    wl.touching[k] = 1;
+    wl.history[k * 3] = static_cast<double>(s.id[wl.particle[k]]);
+  }
+  std::vector<std::uint32_t> order(s.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>((k * 37) % order.size());
+  s.permute(order);
+  wl.build(s, floor, 0.002, 3);
+  for (std::size_t k = 0; k < wl.particle.size(); ++k) {
+    EXPECT_EQ(wl.touching[k], 1);
+    EXPECT_EQ(wl.history[k * 3], static_cast<double>(s.id[wl.particle[k]]));
+  }
+}
+
+TEST(Suggest, DidYouMeanOrFullList) {
+  EXPECT_EQ(suggest("hertzz", {"hertz", "linear"}), "did you mean 'hertz'?");
+  EXPECT_EQ(suggest("spring", {"linear", "hertz"}), "valid: hertz, linear");
+  EXPECT_EQ(suggest("x", {}), "");
+}
