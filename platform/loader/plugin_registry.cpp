@@ -7,6 +7,7 @@
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -65,7 +66,7 @@ void PluginRegistry::load(const std::filesystem::path& path) {
   const auto file = ec ? path : canonical;
   for (const auto& lib : libraries_)
     if (lib.path == file) return;
-  if (!std::filesystem::exists(file)) refuse(file, "no such file");
+  if (!std::filesystem::exists(file)) refuse(file, "file not found");
 
   boost::dll::shared_library handle;
   try {
@@ -108,6 +109,14 @@ void PluginRegistry::load(const std::filesystem::path& path) {
                      std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR) +
                      ": upgrade domel or rebuild the plugin against this SDK");
   if (lib_name.empty()) refuse(file, "its library description has no name");
+  // The same library reached through two folders (build tree and install
+  // prefix, or a folder listed twice): keep the first, say so in the debug log.
+  for (const auto& other : libraries_)
+    if (other.name == lib_name && other.version == lib_version) {
+      spdlog::debug("plugin '{}': library '{}' {} already loaded from '{}'; skipped", file.string(), lib_name,
+                    lib_version, other.path.string());
+      return;
+    }
   if (lib->model_count == 0 || lib->models == nullptr)
     refuse(file, who + " registers no models");
 

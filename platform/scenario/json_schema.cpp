@@ -452,8 +452,9 @@ struct SchemaValidator::State {
         const std::string expected = e->size() == 1 ? list
                                      : e->empty()   ? "no value (empty enum)"
                                                     : "one of " + list;
-        const std::string hint =
-            v.is_string() ? suggest(v.get<std::string>(), names) : std::string();
+        // Only a "did you mean": the message already lists every valid value.
+        std::string hint = v.is_string() ? suggest(v.get<std::string>(), names) : std::string();
+        if (hint.rfind("did you mean", 0) != 0) hint.clear();
         if (stop(fail(out, ptr, "expected " + expected + ", found " + found_literal(v), hint)))
           return false;
       }
@@ -624,6 +625,27 @@ struct SchemaValidator::State {
     }
     if (matching.size() == 1) return true;
     if (matching.size() > 1) {
+      // Branches that only require keys ("oneOf": [{"required": ["a"]}, {"required": ["b"]}])
+      // express "give exactly one of a, b": say that in those words.
+      std::vector<std::string> keys;
+      bool only_required = exactly_one;
+      for (const auto& b : branches) {
+        if (!b.is_object() || b.size() != 1 || !b.contains("required") || b["required"].size() != 1 ||
+            !b["required"][0].is_string()) {
+          only_required = false;
+          break;
+        }
+        keys.push_back("'" + b["required"][0].get<std::string>() + "'");
+      }
+      if (only_required) {
+        std::string list, given;
+        for (std::size_t i = 0; i < keys.size(); ++i)
+          list += (i == 0 ? "" : i + 1 == keys.size() ? " or " : ", ") + keys[i];
+        for (std::size_t i = 0; i < matching.size(); ++i)
+          given += (i == 0 ? "" : i + 1 == matching.size() ? " and " : ", ") + keys[matching[i]];
+        return fail(out, ptr, "expected exactly one of " + list + ", found " + given,
+                    "remove all but one of them");
+      }
       std::string which;
       for (std::size_t i = 0; i < matching.size(); ++i)
         which += (i ? ", " : "") + std::to_string(matching[i] + 1);

@@ -326,7 +326,8 @@ std::vector<Diagnostic> validate_document(const json& doc, const std::filesystem
       try {
         registry.load(p);
       } catch (const PluginError& e) {
-        ck.add(idx("/plugins", k), e.what());
+        ck.add(idx("/plugins", k), e.what(),
+               std::filesystem::exists(p) ? std::string() : "paths in \"plugins\" are relative to the scenario's folder");
       }
     }
   }
@@ -352,7 +353,8 @@ json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& 
     std::string what = e.what();
     const auto pos = what.find("] ");
     if (pos != std::string::npos) what = what.substr(pos + 2);
-    diags.push_back({file.string(), "", "not valid JSON: " + what, ""});
+    diags.push_back({file.string(), "", "not valid JSON: " + what,
+                     "look for a missing ',' or '\"' just before that position, or a trailing ','"});
     return {};
   }
 }

@@ -10,6 +10,14 @@ function(domel_add_plugin name)
     C_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON
     PREFIX "lib")
+  # Export only entry symbols (domel_plugin_entry_v<major>): a version script also hides the weak
+  # C++ standard-library instantiations that -fvisibility=hidden leaves visible.
+  if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
+    set(map ${CMAKE_CURRENT_BINARY_DIR}/${name}.exports.map)
+    file(WRITE ${map} "{ global: domel_plugin_entry_v*; local: *; };\n")
+    target_link_options(${name} PRIVATE "LINKER:--version-script=${map}")
+    set_property(TARGET ${name} APPEND PROPERTY LINK_DEPENDS ${map})
+  endif()
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})
   endif()

@@ -53,7 +53,8 @@ class Params {
   double number(const char* key) const {
     auto it = j_.find(key);
     if (it == j_.end() || !it->is_number())
-      throw ParameterError(std::string("missing required number '") + key + "'");
+      throw ParameterError(std::string(it == j_.end() ? "missing required number '" : "expected a number for '") +
+                           key + "'");
     return it->get<double>();
   }
   double number_or(const char* key, double fallback) const {

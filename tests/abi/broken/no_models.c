@@ -1,0 +1,11 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * Broken plugin (case f): a well-formed library descriptor with
+ * model_count == 0 — a library that registers nothing.
+ */
+#include <domel/sdk/abi.h>
+
+static const domel_library_v1 kLibrary = {
+    sizeof(domel_library_v1), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "no_models", "1.0.0", 0u, NULL};
+
+DOMEL_EXPORT const domel_library_v1* domel_plugin_entry_v1(void) { return &kLibrary; }

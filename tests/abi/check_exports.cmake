@@ -1,0 +1,70 @@
+# Symbol-visibility check for plugin libraries, run by ctest:
+#   cmake -DNM=<nm> -P check_exports.cmake <library>...
+# Each library must export (as a defined dynamic symbol) domel_plugin_entry_v1
+# and no other symbol of ours: nothing whose name starts with "domel", and,
+# once demangled, nothing from the C++ namespace domel:: (a leaked template
+# instantiation of the SDK layer would show up there).
+if(NOT NM)
+  set(NM nm)
+endif()
+
+# Everything after the script name on the command line is a library.
+set(libraries "")
+set(after_script FALSE)
+math(EXPR last "${CMAKE_ARGC} - 1")
+foreach(i RANGE 0 ${last})
+  if(after_script)
+    list(APPEND libraries "${CMAKE_ARGV${i}}")
+  elseif(CMAKE_ARGV${i} MATCHES "check_exports\\.cmake$")
+    set(after_script TRUE)
+  endif()
+endforeach()
+if(NOT libraries)
+  message(FATAL_ERROR "check_exports: no library given")
+endif()
+
+set(failures "")
+foreach(lib IN LISTS libraries)
+  if(NOT EXISTS "${lib}")
+    list(APPEND failures "${lib}: does not exist (build the plugins first)")
+    continue()
+  endif()
+  foreach(mode raw demangled)
+    if(mode STREQUAL "raw")
+      execute_process(COMMAND ${NM} -D --defined-only "${lib}"
+                      OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+    else()
+      execute_process(COMMAND ${NM} -D -C --defined-only "${lib}"
+                      OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+    endif()
+    if(NOT rc EQUAL 0)
+      list(APPEND failures "${lib}: ${NM} failed (${rc}): ${err}")
+      continue()
+    endif()
+    string(REPLACE ";" "\\;" out "${out}")
+    string(REPLACE "\n" ";" lines "${out}")
+    set(has_entry FALSE)
+    foreach(line IN LISTS lines)
+      # "<address> <type> <name>"; the demangled name may contain spaces.
+      if(NOT line MATCHES "^[0-9a-fA-F]+ [A-Za-z] (.+)$")
+        continue()
+      endif()
+      set(name "${CMAKE_MATCH_1}")
+      if(name STREQUAL "domel_plugin_entry_v1")
+        set(has_entry TRUE)
+      elseif(name MATCHES "^domel" OR name MATCHES "domel::")
+        list(APPEND failures "${lib}: exports '${name}'")
+      endif()
+    endforeach()
+    if(NOT has_entry)
+      list(APPEND failures "${lib}: does not export domel_plugin_entry_v1 (${mode} listing)")
+    endif()
+  endforeach()
+  message(STATUS "checked exports of ${lib}")
+endforeach()
+
+if(failures)
+  list(REMOVE_DUPLICATES failures)
+  string(REPLACE ";" "\n  " text "${failures}")
+  message(FATAL_ERROR "plugin symbol visibility check failed:\n  ${text}")
+endif()

@@ -1,0 +1,342 @@
+// SPDX-License-Identifier: MIT
+//
+// ABI acceptance tests for the plugin loader. Each refusal case loads a
+// deliberately broken plugin library built from tests/abi/broken/ and checks
+// that PluginRegistry::load throws PluginError whose message names the file
+// ("plugin '<canonical path>' refused: ...") and the specific reason. Further
+// tests cover what the host does with a valid plugin that misbehaves at run
+// time (create refusing its parameters, a kernel failing) and the registry's
+// bookkeeping: refused libraries leave no trace, load_directory keeps going
+// past a broken library, and loading the same file twice is a no-op.
+#include "core/error.hpp"
+#include "loader/plugin_registry.hpp"
+
+#include <domel/sdk/abi.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using domel::platform::ModelInstance;
+using domel::platform::PluginError;
+using domel::platform::PluginRegistry;
+
+fs::path module_file(const char* dir, const std::string& name) {
+  return fs::path(dir) / (std::string(DOMEL_ABI_MODULE_PREFIX) + name + DOMEL_ABI_MODULE_SUFFIX);
+}
+fs::path broken(const std::string& name) { return module_file(DOMEL_ABI_BROKEN_DIR, name); }
+fs::path good(const std::string& name) { return module_file(DOMEL_ABI_GOOD_DIR, name); }
+
+/// The path as the registry reports it.
+std::string shown(const fs::path& p) { return fs::weakly_canonical(p).string(); }
+
+/// Load `file` into `registry`, expecting a refusal; returns the message
+/// ("" and a test failure if the library was accepted). Checks the common
+/// "plugin '<file>' refused: " prefix and prints the message for the record.
+std::string refusal(PluginRegistry& registry, const fs::path& file) {
+  try {
+    registry.load(file);
+  } catch (const PluginError& e) {
+    const std::string message = e.what();
+    std::cout << "[refusal] " << message << "\n";
+    const std::string prefix = "plugin '" + shown(file) + "' refused: ";
+    EXPECT_EQ(message.rfind(prefix, 0), 0u) << "message does not start with \"" << prefix << "\": " << message;
+    return message;
+  }
+  ADD_FAILURE() << file << " was accepted, expected a refusal";
+  return "";
+}
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "missing \"" << (needle) << "\" in: " << (haystack)
+
+/// A contact batch of n contacts with every array allocated (one rolling or
+/// twisting stage reads kinematics and fn and adds torque).
+struct Batch {
+  explicit Batch(uint32_t n)
+      : overlap(n, 1e-5), nx(n, 0.0), ny(n, 0.0), nz(n, 1.0), r_eff(n, 5e-4), m_eff(n, 1e-3), radius_i(n, 1e-3),
+        radius_j(n, 1e-3), vn(n, 0.1), vt(n, 0.0), wx(n, 0.0), wy(n, 0.0), wz(n, 10.0), out(n, 0.0),
+        fn(n, 2.0), tqx(n, 0.0), tqy(n, 0.0), tqz(n, 0.0) {
+    pair.struct_size = sizeof pair;
+    pair.youngs_eff = 1e7;
+    pair.shear_eff = 4e6;
+    pair.restitution = 0.9;
+    pair.friction = 0.5;
+    pair.coarse_grain = 1.0;
+    b.struct_size = sizeof b;
+    b.n = n;
+    b.dt = 1e-6;
+    b.pair = &pair;
+    b.overlap = overlap.data();
+    b.nx = nx.data(); b.ny = ny.data(); b.nz = nz.data();
+    b.r_eff = r_eff.data(); b.m_eff = m_eff.data();
+    b.radius_i = radius_i.data(); b.radius_j = radius_j.data();
+    b.vn = vn.data();
+    b.vtx = vt.data(); b.vty = vt.data(); b.vtz = vt.data();
+    b.wx = wx.data(); b.wy = wy.data(); b.wz = wz.data();
+    b.fn_elastic = out.data(); b.kn = out.data(); b.kn_tangent = out.data(); b.contact_radius = out.data();
+    b.fn_damping = out.data(); b.eta_n = out.data();
+    b.fn = fn.data();
+    b.ftx = out.data(); b.fty = out.data(); b.ftz = out.data();
+    b.tqx = tqx.data(); b.tqy = tqy.data(); b.tqz = tqz.data();
+  }
+  domel_pair_v1 pair{};
+  std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, vn, vt, wx, wy, wz, out, fn, tqx, tqy, tqz;
+  domel_contact_batch_v1 b{};
+};
+
+/// Every broken library of tests/abi/broken, by file stem.
+const std::vector<std::string> kBroken = {"abi_major_2",      "entry_v2_only", "not_a_plugin",
+                                          "missing_create",   "missing_contact", "no_models",
+                                          "duplicate_within", "bad_schema",    "newer_minor"};
+
+}  // namespace
+
+// Guards the fixtures: the good plugins load and work, so every refusal below is due to its one defect.
+TEST(AbiLoader, ValidPluginsLoadAndRun) {
+  PluginRegistry registry;
+  registry.load(good("good_plugin"));
+  registry.load(good("failing_kernel"));
+  ASSERT_EQ(registry.libraries().size(), 2u);
+  const auto* rolling = registry.find(DOMEL_KIND_ROLLING, "abi_good_rolling");
+  ASSERT_NE(rolling, nullptr);
+  EXPECT_EQ(rolling->version, "1.2.3");
+  EXPECT_EQ(registry.libraries()[rolling->library].path.string(), shown(good("good_plugin")));
+  ASSERT_NE(registry.find(DOMEL_KIND_TWISTING, "abi_failing_twisting"), nullptr);
+
+  ModelInstance instance(*rolling, {{"model", "abi_good_rolling"}, {"coefficient", 0.1}}, "test");
+  Batch batch(2);
+  instance.contact(batch.b);
+  // -mu_r R* F_n along omega (z): -0.1 * 5e-4 * 2.
+  EXPECT_DOUBLE_EQ(batch.tqz[0], -1e-4);
+  EXPECT_DOUBLE_EQ(batch.tqz[1], -1e-4);
+  EXPECT_EQ(batch.tqx[0], 0.0);
+}
+
+// Guards case (a): a library descriptor with ABI major 2 is refused on the major.
+TEST(AbiLoader, RefusesAbiMajorMismatch) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("abi_major_2"));
+  EXPECT_CONTAINS(m, "library 'abi_major_2'");
+  EXPECT_CONTAINS(m, "built against domel SDK ABI 2.0");
+  EXPECT_CONTAINS(m, "needs ABI major " + std::to_string(DOMEL_ABI_MAJOR));
+  EXPECT_TRUE(registry.models().empty());
+}
+
+// Guards case (b): an SDK-2 plugin (only domel_plugin_entry_v2) is named as such, not as "not a plugin".
+TEST(AbiLoader, RefusesEntryOfAnotherMajor) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("entry_v2_only"));
+  EXPECT_CONTAINS(m, "exports 'domel_plugin_entry_v2'");
+  EXPECT_CONTAINS(m, "built against domel SDK ABI 2.x");
+  EXPECT_CONTAINS(m, "loads ABI " + std::to_string(DOMEL_ABI_MAJOR) + ".x plugins");
+}
+
+// Guards case (c): a shared library without the entry symbol is refused as "not a domel plugin".
+TEST(AbiLoader, RefusesLibraryWithoutEntrySymbol) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("not_a_plugin"));
+  EXPECT_CONTAINS(m, "not a domel plugin");
+  EXPECT_CONTAINS(m, "does not export 'domel_plugin_entry_v1'");
+}
+
+// Guards case (d): a model whose create is NULL is refused, naming the model and 'create'.
+TEST(AbiLoader, RefusesModelWithoutCreate) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("missing_create"));
+  EXPECT_CONTAINS(m, "normal model 'missing_create_normal'");
+  EXPECT_CONTAINS(m, "lacks required member 'create'");
+}
+
+// Guards case (e): a contact-kind model whose contact kernel is NULL is refused, naming 'contact'.
+TEST(AbiLoader, RefusesContactModelWithoutKernel) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("missing_contact"));
+  EXPECT_CONTAINS(m, "tangential model 'missing_contact_tangential'");
+  EXPECT_CONTAINS(m, "lacks required member 'contact'");
+}
+
+// Guards case (f): a library with model_count 0 is refused as registering nothing.
+TEST(AbiLoader, RefusesLibraryThatRegistersNothing) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("no_models"));
+  EXPECT_CONTAINS(m, "library 'no_models'");
+  EXPECT_CONTAINS(m, "registers no models");
+}
+
+// Guards case (g): a (kind, name) already provided by another library is refused, naming that library's file.
+TEST(AbiLoader, RefusesDuplicateModelAcrossLibraries) {
+  PluginRegistry registry;
+  registry.load(good("good_plugin"));
+  const std::string m = refusal(registry, broken("duplicate_of_good"));
+  EXPECT_CONTAINS(m, "duplicate rolling model 'abi_good_rolling'");
+  EXPECT_CONTAINS(m, "already provided by '" + shown(good("good_plugin")) + "'");
+  // The first registration stands.
+  const auto* kept = registry.find(DOMEL_KIND_ROLLING, "abi_good_rolling");
+  ASSERT_NE(kept, nullptr);
+  EXPECT_EQ(kept->version, "1.2.3");
+}
+
+// Guards case (g): the same (kind, name) twice inside one library is refused.
+TEST(AbiLoader, RefusesDuplicateModelWithinLibrary) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("duplicate_within"));
+  EXPECT_CONTAINS(m, "duplicate normal model 'duplicate_twin'");
+  EXPECT_CONTAINS(m, "within the library");
+  EXPECT_TRUE(registry.models().empty());
+}
+
+// Guards case (h): a params_schema_json that is not JSON is refused at load time.
+TEST(AbiLoader, RefusesInvalidParameterSchema) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("bad_schema"));
+  EXPECT_CONTAINS(m, "rolling model 'bad_schema_rolling'");
+  EXPECT_CONTAINS(m, "invalid parameter schema");
+}
+
+// Guards case (i): a library built against a newer ABI minor than the host is refused as "newer".
+TEST(AbiLoader, RefusesNewerAbiMinor) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("newer_minor"));
+  EXPECT_CONTAINS(m, "newer");
+  EXPECT_CONTAINS(m, "ABI " + std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR + 1));
+  EXPECT_CONTAINS(m, "supports up to " + std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR));
+}
+
+// Guards case (j): a path that does not exist is refused with "not found".
+TEST(AbiLoader, RefusesMissingFile) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("does_not_exist"));
+  EXPECT_CONTAINS(m, "not found");
+}
+
+// Guards case (k): create() refusing bad parameters becomes PluginError with the model name and the plugin's message.
+TEST(AbiLoader, CreateRefusalCarriesPluginMessage) {
+  PluginRegistry registry;
+  registry.load(good("good_plugin"));
+  const auto* model = registry.find(DOMEL_KIND_ROLLING, "abi_good_rolling");
+  ASSERT_NE(model, nullptr);
+  const std::string where = "scenario.json: at /subdomains/0/contact/rolling";
+  const std::vector<std::pair<nlohmann::json, std::string>> cases = {
+      {{{"coefficient", -1.0}}, "abi_good_rolling wants a positive 'coefficient', got -1"},
+      {nlohmann::json::object(), "abi_good_rolling needs a 'coefficient'"},
+      {{{"coefficient", "large"}}, "expected a number for 'coefficient'"}};  // the SDK's Params message
+  for (const auto& [bad, own_message] : cases) {
+    try {
+      ModelInstance instance(*model, bad, where);
+      ADD_FAILURE() << "create accepted " << bad.dump();
+    } catch (const PluginError& e) {
+      const std::string m = e.what();
+      std::cout << "[create refusal] " << m << "\n";
+      EXPECT_EQ(m.rfind(where + ": ", 0), 0u) << m;
+      EXPECT_CONTAINS(m, "rolling model 'abi_good_rolling' refused its parameters: ");
+      EXPECT_CONTAINS(m, own_message);
+    }
+  }
+}
+
+// Guards case (l): a kernel returning DOMEL_ERR_RUNTIME throws PluginError with its message; the host stays usable.
+TEST(AbiLoader, KernelFailureBecomesPluginError) {
+  PluginRegistry registry;
+  registry.load(good("failing_kernel"));
+  const auto* model = registry.find(DOMEL_KIND_TWISTING, "abi_failing_twisting");
+  ASSERT_NE(model, nullptr);
+  ModelInstance instance(*model, nlohmann::json::object(), "test");
+  Batch batch(3);
+  for (int call = 0; call < 2; ++call) {  // a second call proves the instance survived the first failure
+    try {
+      instance.contact(batch.b);
+      ADD_FAILURE() << "the failing kernel reported success";
+    } catch (const PluginError& e) {
+      const std::string m = e.what();
+      if (call == 0) std::cout << "[kernel failure] " << m << "\n";
+      EXPECT_CONTAINS(m, "twisting model 'abi_failing_twisting' failed");
+      EXPECT_CONTAINS(m, "deliberate failure on a batch of 3 contacts");
+    }
+  }
+}
+
+// Guards atomicity: a refused library registers none of its models, even the valid ones listed before the bad one.
+TEST(AbiLoader, RefusedLibraryLeavesRegistryUnchanged) {
+  PluginRegistry registry;
+  registry.load(good("good_plugin"));
+  const std::size_t libraries = registry.libraries().size();
+  const std::size_t models = registry.models().size();
+  std::vector<std::string> all = kBroken;
+  all.push_back("duplicate_of_good");
+  for (const auto& name : all) {
+    EXPECT_THROW(registry.load(broken(name)), PluginError) << name;
+    EXPECT_EQ(registry.libraries().size(), libraries) << name;
+    EXPECT_EQ(registry.models().size(), models) << name;
+  }
+  EXPECT_EQ(registry.find(DOMEL_KIND_DAMPING, "missing_create_valid"), nullptr);
+  EXPECT_EQ(registry.find(DOMEL_KIND_DAMPING, "duplicate_of_good_unique"), nullptr);
+  EXPECT_EQ(registry.find(DOMEL_KIND_NORMAL, "duplicate_twin"), nullptr);
+  // A refused file is not remembered as loaded: trying it again refuses it again.
+  EXPECT_THROW(registry.load(broken("missing_create")), PluginError);
+  // And the registry still takes good libraries afterwards.
+  registry.load(good("failing_kernel"));
+  EXPECT_EQ(registry.libraries().size(), libraries + 1);
+}
+
+// Guards load_directory: a broken library in a folder is recorded in refused() and does not stop the good one.
+TEST(AbiLoader, LoadDirectoryKeepsGoodAndRecordsBroken) {
+  const fs::path dir = fs::temp_directory_path() / ("domel_abi_mixed_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path good_copy = dir / good("good_plugin").filename();
+  const fs::path broken_copy = dir / broken("missing_contact").filename();
+  fs::copy_file(good("good_plugin"), good_copy);
+  fs::copy_file(broken("missing_contact"), broken_copy);
+  {
+    PluginRegistry registry;
+    EXPECT_EQ(registry.load_directory(dir), 1u);
+    ASSERT_EQ(registry.libraries().size(), 1u);
+    EXPECT_EQ(registry.libraries()[0].path.string(), shown(good_copy));
+    EXPECT_NE(registry.find(DOMEL_KIND_ROLLING, "abi_good_rolling"), nullptr);
+    ASSERT_EQ(registry.refused().size(), 1u);
+    std::cout << "[refused()] " << registry.refused()[0] << "\n";
+    EXPECT_CONTAINS(registry.refused()[0], "plugin '" + shown(broken_copy) + "' refused: ");
+    EXPECT_CONTAINS(registry.refused()[0], "lacks required member 'contact'");
+  }
+  fs::remove_all(dir);
+}
+
+// Guards load_directory over the whole broken folder: every broken library is refused, each message naming its own file.
+TEST(AbiLoader, LoadDirectoryOfBrokenLibrariesLoadsNothing) {
+  PluginRegistry registry;
+  // duplicate_of_good is valid on its own (it only clashes with good_plugin), so it is the one that loads.
+  EXPECT_EQ(registry.load_directory(DOMEL_ABI_BROKEN_DIR), 1u);
+  ASSERT_EQ(registry.libraries().size(), 1u);
+  EXPECT_EQ(registry.libraries()[0].name, "duplicate_of_good");
+  ASSERT_EQ(registry.refused().size(), kBroken.size());
+  for (const auto& name : kBroken) {
+    const std::string prefix = "plugin '" + shown(broken(name)) + "' refused: ";
+    std::size_t hits = 0;
+    for (const auto& r : registry.refused()) hits += r.rfind(prefix, 0) == 0 ? 1 : 0;
+    EXPECT_EQ(hits, 1u) << name;
+  }
+}
+
+// Guards idempotence: loading the same file twice (also under another spelling of its path) is a no-op.
+TEST(AbiLoader, LoadingSamePathTwiceIsNoOp) {
+  PluginRegistry registry;
+  registry.load(good("good_plugin"));
+  registry.load(good("good_plugin"));
+  registry.load(fs::path(DOMEL_ABI_GOOD_DIR) / ".." / "good" / good("good_plugin").filename());
+  EXPECT_EQ(registry.libraries().size(), 1u);
+  EXPECT_EQ(registry.models().size(), 1u);
+  EXPECT_EQ(registry.load_directory(DOMEL_ABI_GOOD_DIR), 2u);  // load() counts the no-op as loaded
+  EXPECT_EQ(registry.libraries().size(), 2u);                  // only failing_kernel is new
+  EXPECT_TRUE(registry.refused().empty());
+}

@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: MIT
+// Guards the domel command line end to end: exit codes (0 ok, 2 refused, 64
+// usage), that a refused run writes nothing, the files a run leaves behind
+// (summary.json contents, probes.csv, ParaView files, no temporaries), and
+// the output of the plugins, schema, docs and version commands. Runs the
+// built executable <build>/bin/domel with stdout and stderr captured to files.
+#include "scenario/json_schema.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kDomel = DOMEL_BINARY_DIR "/bin/domel";
+const fs::path kSettle = fs::path(DOMEL_SOURCE_DIR) / "scenarios" / "examples" / "settle.json";
+const fs::path kCases = fs::path(DOMEL_SOURCE_DIR) / "tests" / "config" / "cases";
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Single-quotes an argument for /bin/sh.
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    static std::atomic<int> counter{0};
+    const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+    tmp_ = fs::temp_directory_path() /
+           ("domel_cli_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" +
+            std::to_string(stamp));
+    fs::create_directories(tmp_);
+    ASSERT_TRUE(fs::is_regular_file(kDomel)) << "the domel executable is missing: " << kDomel;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+
+  /// Runs domel with the arguments; stdout/stderr are captured to files in tmp_.
+  Result domel(const std::vector<std::string>& args) {
+    const fs::path out = tmp_ / "stdout.txt", err = tmp_ / "stderr.txt";
+    std::string cmd = shell_quote(kDomel);
+    for (const auto& a : args) cmd += " " + shell_quote(a);
+    cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string()) + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.exit_code = status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = read_file(out);
+    r.err = read_file(err);
+    return r;
+  }
+
+  static std::string show(const Result& r) {
+    return "exit code " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out + "\n--- stderr ---\n" + r.err;
+  }
+
+  fs::path tmp_;
+};
+
+// ---- validate ----------------------------------------------------------------
+
+TEST_F(Cli, ValidateGoodScenarioSaysValid) {
+  const Result r = domel({"validate", kSettle.string()});
+  EXPECT_EQ(r.exit_code, 0) << show(r);
+  EXPECT_NE(r.out.find(kSettle.string() + ": valid"), std::string::npos) << show(r);
+}
+
+TEST_F(Cli, ValidateBadScenarioIsRefusedNamingFileAndPointer) {
+  const fs::path bad = kCases / "normal_model_typo.json";
+  const Result r = domel({"validate", bad.string()});
+  EXPECT_EQ(r.exit_code, 2) << show(r);
+  EXPECT_NE(r.err.find(bad.string()), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("/subdomains/0/contact/normal/model"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("did you mean 'hertz'?"), std::string::npos) << show(r);
+  EXPECT_EQ(r.out.find("valid"), std::string::npos) << show(r);
+}
+
+TEST_F(Cli, ValidateSeveralFilesReportsEachAndFailsIfAnyIsBad) {
+  const fs::path bad = kCases / "restitution_out_of_range.json";
+  const Result r = domel({"validate", kSettle.string(), bad.string()});
+  EXPECT_EQ(r.exit_code, 2) << show(r);
+  EXPECT_NE(r.out.find(kSettle.string() + ": valid"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("/interactions/0/restitution"), std::string::npos) << show(r);
+}
+
+// ---- run ---------------------------------------------------------------------
+
+TEST_F(Cli, RunOfBadScenarioIsRefusedAndWritesNothing) {
+  const fs::path out = tmp_ / "x";
+  const fs::path bad = kCases / "wall_material_unknown.json";
+  const Result r = domel({"run", bad.string(), "--out", out.string(), "--quiet"});
+  EXPECT_EQ(r.exit_code, 2) << show(r);
+  EXPECT_NE(r.err.find(bad.string()), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("/walls/0/material"), std::string::npos) << show(r);
+  EXPECT_FALSE(fs::exists(out)) << "a refused run created " << out;
+}
+
+// A problem found only while building (after particles were inserted) must
+// leave nothing behind either.
+TEST_F(Cli, RunRefusedAtBuildStageWritesNothing) {
+  const fs::path out = tmp_ / "x";
+  const fs::path bad = kCases / "time_step_too_large.json";
+  const Result r = domel({"run", bad.string(), "--out", out.string(), "--quiet"});
+  EXPECT_EQ(r.exit_code, 2) << show(r);
+  EXPECT_NE(r.err.find("/subdomains/0/time_step"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("stability limit"), std::string::npos) << show(r);
+  EXPECT_FALSE(fs::exists(out)) << "a refused run created " << out;
+}
+
+TEST_F(Cli, RunWritesCompleteOutputs) {
+  const fs::path out = tmp_ / "y";
+  const Result r = domel({"run", kSettle.string(), "--out", out.string(), "--max-steps", "50", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+
+  ASSERT_TRUE(fs::is_regular_file(out / "summary.json")) << show(r);
+  json summary;
+  ASSERT_NO_THROW(summary = json::parse(read_file(out / "summary.json")));
+  ASSERT_TRUE(summary.is_object());
+  EXPECT_TRUE(summary.contains("domel_version") && summary["domel_version"].is_string() &&
+              !summary["domel_version"].get<std::string>().empty())
+      << summary.dump(2);
+  ASSERT_TRUE(summary.contains("plugin_libraries") && summary["plugin_libraries"].is_array()) << summary.dump(2);
+  EXPECT_FALSE(summary["plugin_libraries"].empty()) << summary.dump(2);
+  for (const auto& lib : summary["plugin_libraries"]) {
+    EXPECT_TRUE(lib.contains("name") && lib["name"].is_string()) << lib.dump();
+    EXPECT_TRUE(lib.contains("version") && lib["version"].is_string() && !lib["version"].get<std::string>().empty())
+        << lib.dump();
+  }
+  ASSERT_TRUE(summary.contains("steps") && summary["steps"].is_number_integer()) << summary.dump(2);
+  EXPECT_EQ(summary["steps"].get<long long>(), 50);
+  ASSERT_TRUE(summary.contains("particle_steps_per_s") && summary["particle_steps_per_s"].is_number())
+      << summary.dump(2);
+  EXPECT_GT(summary["particle_steps_per_s"].get<double>(), 0.0);
+
+  EXPECT_TRUE(fs::is_regular_file(out / "probes.csv"));
+  EXPECT_TRUE(fs::is_regular_file(out / "particles.pvd"));
+  int vtp = 0;
+  std::vector<std::string> temporaries;
+  for (const auto& e : fs::recursive_directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() == ".vtp") ++vtp;
+    if (name.find(".tmp-") != std::string::npos) temporaries.push_back(name);
+  }
+  EXPECT_GE(vtp, 1) << "no .vtp file in " << out;
+  EXPECT_TRUE(temporaries.empty()) << "left-over temporary file " << temporaries.front();
+}
+
+// ---- plugins -------------------------------------------------------------------
+
+TEST_F(Cli, PluginsListsModelsWithVersionsAndAbi) {
+  const Result r = domel({"plugins"});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(library \S+ \S+ \(ABI \d+\.\d+\))"))) << show(r);
+  for (const char* model : {"hertz", "mindlin", "lattice"})
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(std::string(R"(\s)") + model + R"(\s+\d+\.\d+\.\d+\s)")))
+        << model << " with a version\n" << show(r);
+}
+
+TEST_F(Cli, PluginsJsonParses) {
+  const Result r = domel({"plugins", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+  json list;
+  ASSERT_NO_THROW(list = json::parse(r.out)) << show(r);
+  ASSERT_TRUE(list.is_array());
+  for (const char* model : {"hertz", "mindlin", "lattice"}) {
+    bool found = false;
+    for (const auto& m : list) {
+      if (m.value("name", "") != model) continue;
+      found = true;
+      EXPECT_FALSE(m.value("version", "").empty()) << m.dump();
+      EXPECT_TRUE(std::regex_match(m.value("abi", ""), std::regex(R"(\d+\.\d+)"))) << m.dump();
+      EXPECT_TRUE(m.contains("parameters")) << m.dump();
+    }
+    EXPECT_TRUE(found) << model << " missing from `domel plugins --json`";
+  }
+}
+
+// ---- schema and docs -----------------------------------------------------------
+
+TEST_F(Cli, SchemaHasEveryNormalModelAndIsUsableBySchemaValidator) {
+  const Result r = domel({"schema"});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+  json schema;
+  ASSERT_NO_THROW(schema = json::parse(r.out)) << show(r);
+  ASSERT_TRUE(schema.contains("$defs")) << show(r);
+  const json& normal = schema["$defs"]["normal_model"];
+  ASSERT_TRUE(normal.contains("oneOf") && normal["oneOf"].is_array()) << normal.dump(2);
+  std::vector<std::string> names;
+  for (const auto& alt : normal["oneOf"])
+    if (alt.contains("properties") && alt["properties"].contains("model") &&
+        alt["properties"]["model"].contains("const"))
+      names.push_back(alt["properties"]["model"]["const"].get<std::string>());
+  for (const char* model : {"hertz", "linear"})
+    EXPECT_NE(std::find(names.begin(), names.end(), model), names.end()) << model << " not in normal_model.oneOf";
+
+  // The printed schema is one domel's own validator accepts, and it accepts
+  // the example scenario.
+  std::unique_ptr<domel::platform::SchemaValidator> validator;
+  ASSERT_NO_THROW(validator = std::make_unique<domel::platform::SchemaValidator>(schema));
+  std::vector<domel::platform::Diagnostic> diags;
+  validator->validate(json::parse(read_file(kSettle)), diags);
+  for (const auto& d : diags) ADD_FAILURE() << "the composed schema refuses settle.json: " << d.format();
+}
+
+TEST_F(Cli, SchemaOutWritesTheSameText) {
+  const fs::path file = tmp_ / "schema.json";
+  const Result printed = domel({"schema"});
+  const Result written = domel({"schema", "--out", file.string()});
+  ASSERT_EQ(written.exit_code, 0) << show(written);
+  EXPECT_EQ(read_file(file), printed.out);
+}
+
+TEST_F(Cli, DocsPrintsMarkdownReference) {
+  const Result r = domel({"docs"});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+  EXPECT_NE(r.out.find("### `hertz`"), std::string::npos) << show(r);
+  EXPECT_NE(r.out.find("### `lattice`"), std::string::npos) << show(r);
+}
+
+// ---- usage errors and version --------------------------------------------------
+
+TEST_F(Cli, UnknownCommandSuggestsTheClosest) {
+  const Result r = domel({"rnu"});
+  EXPECT_EQ(r.exit_code, 64) << show(r);
+  EXPECT_NE(r.err.find("unknown command 'rnu'"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("did you mean 'run'?"), std::string::npos) << show(r);
+}
+
+TEST_F(Cli, UnknownOptionIsAUsageError) {
+  const fs::path out = tmp_ / "z";
+  const Result r = domel({"run", kSettle.string(), "--out", out.string(), "--max-step", "5"});
+  EXPECT_EQ(r.exit_code, 64) << show(r);
+  EXPECT_NE(r.err.find("unknown option --max-step"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("did you mean '--max-steps'?"), std::string::npos) << show(r);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, NoCommandPrintsUsage) {
+  const Result r = domel({});
+  EXPECT_EQ(r.exit_code, 64) << show(r);
+  EXPECT_NE(r.err.find("usage: domel"), std::string::npos) << show(r);
+}
+
+TEST_F(Cli, VersionPrintsVersions) {
+  const Result r = domel({"version"});
+  EXPECT_EQ(r.exit_code, 0) << show(r);
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(^domel \S+ \(SDK ABI \d+\.\d+\))"))) << show(r);
+}
+
+}  // namespace
