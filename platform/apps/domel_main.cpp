@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The domel executable: run, validate, plugins, schema, docs, version.
-// Command-line parsing is a few lines by hand: the sub-commands take at most
-// three options each, which does not justify another dependency.
+// Command-line parsing is a few lines by hand: a handful of --key value
+// options per sub-command does not justify another dependency.
 // Exit codes: 0 success, 1 the run failed, 2 the scenario (or a plugin) was
 // refused, 64 wrong command-line usage.
 #include "core/error.hpp"

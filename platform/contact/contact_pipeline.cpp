@@ -16,7 +16,8 @@ ContactPipeline::ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlo
   for (auto* v : {&buf_.overlap, &buf_.nx, &buf_.ny, &buf_.nz, &buf_.r_eff, &buf_.m_eff, &buf_.radius_i,
                   &buf_.radius_j, &buf_.vn, &buf_.vtx, &buf_.vty, &buf_.vtz, &buf_.wx, &buf_.wy, &buf_.wz,
                   &buf_.fn_elastic, &buf_.kn, &buf_.kn_tangent, &buf_.contact_radius, &buf_.fn_damping,
-                  &buf_.eta_n, &buf_.fn, &buf_.ftx, &buf_.fty, &buf_.ftz, &buf_.tqx, &buf_.tqy, &buf_.tqz})
+                  &buf_.eta_n, &buf_.fn, &buf_.ftx, &buf_.fty, &buf_.ftz, &buf_.tqx, &buf_.tqy, &buf_.tqz,
+                  &buf_.rolling_stiffness, &buf_.rolling_damping})
     v->assign(n, 0.0);
   buf_.history.assign(n * std::max<uint32_t>(history_stride_, 1), 0.0);
 
@@ -35,6 +36,8 @@ ContactPipeline::ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlo
   b.ftx = buf_.ftx.data(); b.fty = buf_.fty.data(); b.ftz = buf_.ftz.data();
   b.tqx = buf_.tqx.data(); b.tqy = buf_.tqy.data(); b.tqz = buf_.tqz.data();
   b.history_stride = history_stride_;
+  b.rolling_stiffness = buf_.rolling_stiffness.data();
+  b.rolling_damping = buf_.rolling_damping.data();
 }
 
 void ContactPipeline::evaluate(const domel_pair_v1& pair, double dt, uint32_t n) {
@@ -55,6 +58,10 @@ void ContactPipeline::evaluate(const domel_pair_v1& pair, double dt, uint32_t n)
   std::fill_n(buf_.tqx.begin(), n, 0.0);
   std::fill_n(buf_.tqy.begin(), n, 0.0);
   std::fill_n(buf_.tqz.begin(), n, 0.0);
+  if (slots_[static_cast<int>(Slot::rolling)]) {
+    std::fill_n(buf_.rolling_stiffness.begin(), n, 0.0);
+    std::fill_n(buf_.rolling_damping.begin(), n, 0.0);
+  }
   run(Slot::rolling);
   run(Slot::twisting);
 }

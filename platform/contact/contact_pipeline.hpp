@@ -37,6 +37,7 @@ class ContactPipeline {
     std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, vn, vtx, vty, vtz, wx, wy, wz;
     std::vector<double> fn_elastic, kn, kn_tangent, contact_radius, fn_damping, eta_n, fn;
     std::vector<double> ftx, fty, ftz, tqx, tqy, tqz;
+    std::vector<double> rolling_stiffness, rolling_damping;
     std::vector<double> history;  ///< kBatchSize * history_stride
   };
   Buffers& buffers() { return buf_; }

@@ -55,15 +55,17 @@ void NeighborList::build(const ParticleStore& s) {
       lo[2] = std::min(lo[2], s.z[k]); hi[2] = std::max(hi[2], s.z[k]);
       rmax = std::max(rmax, s.radius[k]);
     }
+    // Every cell must be at least one cutoff wide, so that all partners of a
+    // particle lie in its own or an adjacent cell: floor(span / cutoff) cells.
     const double cell = 2.0 * rmax + skin_;
     int dim[3];
     for (int a = 0; a < 3; ++a) {
       const double span = hi[a] - lo[a];
-      dim[a] = std::max(1, std::min(1 << 20, static_cast<int>(span / cell) + 1));
+      dim[a] = std::max(1, std::min(1 << 20, static_cast<int>(span / cell)));
     }
-    // Keep the cell count bounded for sparse systems.
+    // Keep the cell count bounded for sparse systems (halving only widens cells).
     while (static_cast<double>(dim[0]) * dim[1] * dim[2] > 8.0 * static_cast<double>(n) + 64) {
-      for (int a = 0; a < 3; ++a) dim[a] = std::max(1, dim[a] / 2 + (dim[a] % 2));
+      for (int a = 0; a < 3; ++a) dim[a] = std::max(1, dim[a] / 2);
     }
     double inv[3];
     for (int a = 0; a < 3; ++a) inv[a] = dim[a] / std::max(hi[a] - lo[a], 1e-300) * (1.0 - 1e-12);
@@ -128,41 +130,6 @@ void NeighborList::build(const ParticleStore& s) {
   built_ids_ = s.id;
   built_size_ = n;
   ++builds_;
-}
-
-void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride) {
-  std::unordered_map<std::uint64_t, std::size_t> old;
-  std::vector<double> old_history;
-  old_history.swap(history);
-  for (std::size_t k = 0; k < particle.size(); ++k)
-    if (touching[k]) old.emplace(particle_id[k], k);
-  particle.clear();
-  particle_id.clear();
-  touching.clear();
-  for (std::size_t k = 0; k < s.size(); ++k) {
-    double d, nx, ny, nz;
-    if (!w.gap(s.x[k], s.y[k], s.z[k], d, nx, ny, nz)) {
-      // outside a mantle's extent now, but may enter within the skin
-      if (w.shape == WallPrimitive::Shape::cylinder_inside) {
-        const double along = (w.axis == 0 ? s.x[k] : w.axis == 1 ? s.y[k] : s.z[k]);
-        if (along < w.lo - s.radius[k] - skin || along > w.hi + s.radius[k] + skin) continue;
-        particle.push_back(static_cast<uint32_t>(k));
-      }
-      continue;
-    }
-    if (d < s.radius[k] + skin) particle.push_back(static_cast<uint32_t>(k));
-  }
-  for (const uint32_t k : particle) particle_id.push_back(s.id[k]);
-  history.assign(particle.size() * stride, 0.0);
-  touching.assign(particle.size(), 0);
-  if (!old.empty() && stride > 0) {
-    for (std::size_t k = 0; k < particle.size(); ++k) {
-      auto it = old.find(particle_id[k]);
-      if (it == old.end()) continue;
-      std::copy_n(old_history.begin() + it->second * stride, stride, history.begin() + k * stride);
-      touching[k] = 1;
-    }
-  }
 }
 
 }  // namespace domel::platform

@@ -10,7 +10,6 @@
 #pragma once
 
 #include "core/particle_store.hpp"
-#include "geometry/wall.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -42,17 +41,6 @@ class NeighborList {
   std::vector<double> x0_, y0_, z0_;
   std::vector<std::uint64_t> built_ids_;
   std::size_t built_size_ = 0;
-  friend class WallNeighbors;
-};
-
-/// Candidate particles of one wall primitive, with per-contact history.
-class WallNeighbors {
- public:
-  void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride);
-  std::vector<uint32_t> particle;      ///< particle indices at this build
-  std::vector<std::uint64_t> particle_id;  ///< their ids (history is carried over by id)
-  std::vector<double> history;
-  std::vector<uint8_t> touching;
 };
 
 }  // namespace domel::platform

@@ -217,8 +217,6 @@ std::vector<std::filesystem::path> default_plugin_directories() {
     dirs.push_back(exe.parent_path().parent_path() / "lib" / "domel" / "plugins");  // install
   } catch (const std::exception&) {
   }
-  dirs.emplace_back(DOMEL_BUILD_PLUGIN_DIR);
-  dirs.emplace_back(DOMEL_INSTALL_PLUGIN_DIR);
   if (const char* env = std::getenv("DOMEL_PLUGIN_PATH")) {
     std::stringstream ss(env);
     std::string item;
@@ -244,7 +242,7 @@ ModelInstance::ModelInstance(const RegisteredModel& model, const nlohmann::json&
   const domel_status st = model.desc.create(text.c_str(), host_services(), &handle_, err, sizeof err);
   if (st != DOMEL_OK || handle_ == nullptr) {
     handle_ = nullptr;
-    throw PluginError(where + ": " + kind_name(model.desc.kind) + " model '" + model.name +
+    throw PluginError((where.empty() ? std::string() : where + ": ") + kind_name(model.desc.kind) + " model '" + model.name +
                       "' refused its parameters: " + (err[0] ? err : "no message"));
   }
 }

@@ -75,9 +75,11 @@ class PluginRegistry {
   std::vector<std::string> refused_;
 };
 
-/// Folders searched for plugins, in order: the built-in folder next to the
-/// executable (build tree: <build>/plugins; install: <prefix>/lib/domel/plugins),
-/// then each entry of $DOMEL_PLUGIN_PATH (':'-separated).
+/// Folders searched for plugins, in order: the built-in folder found from the
+/// executable's own location (build tree: <build>/bin/../plugins; install:
+/// <prefix>/bin/../lib/domel/plugins), then each entry of $DOMEL_PLUGIN_PATH
+/// (':'-separated). No compiled-in absolute path: an installed domel never
+/// scans the tree it was built in.
 std::vector<std::filesystem::path> default_plugin_directories();
 
 /// A live model instance (RAII over create/destroy).

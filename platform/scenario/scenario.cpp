@@ -500,7 +500,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
         continue;
       }
       try {
-        slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), file.string() + ": at " + where);
+        slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), "");
       } catch (const PluginError& e) {
         ck.add(where, e.what());
         ok = false;
@@ -522,13 +522,14 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
                          sim->gravity);
 
     // insertion
+    const std::size_t problems_before_insert = ck.diags.size();
     if (sd.contains("insert")) {
       for (std::size_t q = 0; q < sd["insert"].size(); ++q) {
         const json& block = sd["insert"][q];
         const std::string where = idx(base + "/insert", q);
         const RegisteredModel* m = registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
         try {
-          ModelInstance inst(*m, plugin_params(block, DOMEL_KIND_INSERTION), file.string() + ": at " + where);
+          ModelInstance inst(*m, plugin_params(block, DOMEL_KIND_INSERTION), "");
           ParticleStore& st = sub->store();
           domel_insert_request_v1 req{};
           req.struct_size = sizeof(req);
@@ -560,6 +561,8 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
       }
     }
 
+    if (ck.diags.size() > problems_before_insert) continue;  // no time step from a half-built subdomain
+
     // neighbour skin: fraction of the largest diameter
     double rmax = 0;
     for (double r : sub->store().radius) rmax = std::max(rmax, r);
@@ -567,7 +570,13 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
 
     // time step
     const double v_imp = sd.value("impact_velocity", 1.0);
-    TimeStepReport rep = sub->estimate_time_step(v_imp);
+    TimeStepReport rep;
+    try {
+      rep = sub->estimate_time_step(v_imp);
+    } catch (const PluginError& e) {
+      ck.add(base + "/contact", std::string("the contact model failed while estimating the time step: ") + e.what());
+      continue;
+    }
     const json ts = sd.value("time_step", json("auto"));
     if (sub->store().size() == 0) {
       if (!ts.is_number()) {
@@ -593,9 +602,11 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
                      "expect inaccurate restitution (20-50 steps per contact are usual)",
                      sd_name, rep.chosen, rep.contact_time, rep.contact_time / rep.chosen);
     } else {
-      rep.chosen = std::min(0.2 * rep.rayleigh, rep.contact_time / 50.0);
-      rep.chosen = std::min(rep.chosen, rep.critical);
-      rep.reason = rep.chosen == 0.2 * rep.rayleigh ? "auto: 0.2 x Rayleigh time" : "auto: contact time / 50";
+      const double by_rayleigh = 0.2 * rep.rayleigh, by_contact = rep.contact_time / 50.0;
+      rep.chosen = std::min({by_rayleigh, by_contact, 0.5 * rep.critical});
+      rep.reason = rep.chosen == by_rayleigh   ? "auto: 0.2 x Rayleigh time"
+                   : rep.chosen == by_contact ? "auto: contact time / 50"
+                                              : "auto: half the stability limit of the " + rep.critical_of;
     }
     sub->set_time_step(rep.chosen);
     spdlog::info("subdomain '{}': {} particles, time step {:.4g} s ({}); Rayleigh time {:.4g} s, contact time {:.4g} s "

@@ -55,13 +55,19 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
   rep.rayleigh = M_PI * r * std::sqrt(own_material_.density / g_mod) / (0.1631 * nu + 0.8766);
 
   auto& buf = pipeline_->buffers();
-  auto collide = [&](const domel_pair_v1& pair, double r_eff, double m_eff, double& t_contact, double& dt_crit) {
+  // i_red: rotational inertia of the relative rolling mode (pair of equal
+  // spheres: I/2; sphere on a wall: I), for the rolling spring's own limit
+  // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
+  // (docs/physics.md §3.6).
+  auto collide = [&](const domel_pair_v1& pair, double r_eff, double m_eff, double i_red, double& t_contact,
+                     double& dt_crit, bool& rolling_sets_limit) {
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
     // contact opens, with a step refined until the duration converges.
     double h = 1e-3 * r_eff / impact_velocity;
     double previous = -1.0;
     for (int refine = 0; refine < 12; ++refine) {
       double delta = 0.0, v = impact_velocity, t = 0.0, crit = 1e300;
+      bool rolling = false;
       auto force = [&](double d, double vel) {
         buf.overlap[0] = std::max(d, 1e-300);
         buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_eff; buf.radius_j[0] = 0;
@@ -74,6 +80,16 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
           const double omega = std::sqrt(k / m_eff);
           const double zeta = buf.eta_n[0] / (2.0 * std::sqrt(m_eff * k));
           crit = std::min(crit, 2.0 * (std::sqrt(1.0 + zeta * zeta) - zeta) / omega);
+        }
+        const double k_roll = buf.rolling_stiffness[0];
+        if (k_roll > 0) {
+          const double omega = std::sqrt(k_roll / i_red);
+          const double zeta = buf.rolling_damping[0] / (2.0 * std::sqrt(i_red * k_roll));
+          const double limit = 2.0 * (std::sqrt(1.0 + zeta * zeta) - zeta) / omega;
+          if (limit < crit) {
+            crit = limit;
+            rolling = true;
+          }
         }
         return buf.fn[0];
       };
@@ -89,6 +105,7 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
       } while (delta > 0.0 && n < 2000000);
       t_contact = t;
       dt_crit = crit;
+      rolling_sets_limit = rolling;
       if (previous > 0 && std::fabs(t - previous) < 1e-3 * t) break;
       previous = t;
       if (n > 4000) break;  // resolved well enough
@@ -96,17 +113,20 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
     }
     std::fill(buf.history.begin(), buf.history.end(), 0.0);
   };
+  const double inertia = 0.4 * m * r * r;  // solid sphere
   double tc, crit;
-  collide(self_pair_, 0.5 * r, 0.5 * m, tc, crit);
+  bool rolling = false;
+  collide(self_pair_, 0.5 * r, 0.5 * m, 0.5 * inertia, tc, crit, rolling);
   rep.contact_time = tc;
   rep.critical = crit;
-  rep.critical_of = "particle-particle contact";
+  rep.critical_of = rolling ? "rolling spring of the particle-particle contact" : "particle-particle contact";
   for (std::size_t w = 0; w < wall_pairs_.size(); ++w) {
-    collide(wall_pairs_[w], r, m, tc, crit);
+    collide(wall_pairs_[w], r, m, inertia, tc, crit, rolling);
     rep.contact_time = std::min(rep.contact_time, tc);
     if (crit < rep.critical) {
       rep.critical = crit;
-      rep.critical_of = "contact with wall '" + (*walls_)[w].name + "'";
+      rep.critical_of = std::string(rolling ? "rolling spring of the " : "") + "contact with wall '" +
+                        (*walls_)[w].name + "'";
     }
   }
   return rep;

@@ -13,6 +13,7 @@
 #include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
 #include "geometry/wall.hpp"
+#include "geometry/wall_neighbors.hpp"
 
 #include <memory>
 #include <string>

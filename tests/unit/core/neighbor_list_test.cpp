@@ -6,6 +6,7 @@
 // pair ids across rebuilds and re-ordering of the store.
 #include "core/neighbor_list.hpp"
 #include "core/error.hpp"
+#include "geometry/wall_neighbors.hpp"
 
 #include <gtest/gtest.h>
 
@@ -50,6 +51,33 @@ TEST(NeighborList, FindsExactlyThePairsWithinCutoffOrientedByIds) {
   }
   EXPECT_EQ(found, brute(s, 0.0008));
   EXPECT_GT(found.size(), 100u);
+}
+
+TEST(NeighborList, CellsAreNeverNarrowerThanTheCutoff) {
+  // regression: with floor(span/cutoff) + 1 cells per axis a cell was narrower
+  // than the cutoff and this touching pair (2, 3), 0.9 apart, was missed
+  ParticleStore s;
+  for (double x : {0.0, 0.7, 1.6, 2.3}) s.add(static_cast<std::uint64_t>(s.size() + 1), x, 0, 0, 0.5, 1);
+  NeighborList nl;
+  nl.configure(0.1, 0);
+  nl.build(s);
+  std::set<std::pair<std::uint64_t, std::uint64_t>> found;
+  for (std::size_t k = 0; k < nl.size(); ++k) found.insert({s.id[nl.i[k]], s.id[nl.j[k]]});
+  EXPECT_EQ(found, brute(s, 0.1));
+  // and on many random clouds of every density
+  for (unsigned seed = 0; seed < 200; ++seed) {
+    std::mt19937_64 rng(seed);
+    const std::size_t n = 5 + seed % 60;
+    std::uniform_real_distribution<double> pos(0.0, 0.002 + 0.0002 * (seed % 50)), rad(0.0005, 0.0015);
+    ParticleStore c;
+    for (std::size_t k = 0; k < n; ++k) c.add(k + 1, pos(rng), pos(rng), pos(rng), rad(rng), 1);
+    NeighborList l;
+    l.configure(0.0002, 0);
+    l.build(c);
+    std::set<std::pair<std::uint64_t, std::uint64_t>> got;
+    for (std::size_t k = 0; k < l.size(); ++k) got.insert({c.id[l.i[k]], c.id[l.j[k]]});
+    ASSERT_EQ(got, brute(c, 0.0002)) << "seed " << seed;
+  }
 }
 
 TEST(NeighborList, RebuildsOnlyAfterHalfSkinDisplacement) {

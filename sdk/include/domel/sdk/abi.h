@@ -4,7 +4,7 @@
  *
  * This header is the single source of truth for the binary boundary. It is
  * plain C so a plugin may be built with any compiler and standard library:
- * no STL, Eigen, nlohmann or exceptions cross it. Rules (see docs/sdk.md):
+ * no STL, Eigen, nlohmann or exceptions cross it. Rules (see docs/sdk-guide.md):
  *
  *  - A plugin library exports exactly one symbol, domel_plugin_entry_v1, that
  *    returns a static domel_library_v1 describing every model it provides.
@@ -28,7 +28,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 1
-#define DOMEL_ABI_MINOR 0
+#define DOMEL_ABI_MINOR 1
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -122,6 +122,14 @@ typedef struct domel_contact_batch_v1 {
    * rebuilds and particle re-ordering, and zeroes it when the contact opens. */
   double* history;
   uint32_t history_stride;
+
+  /* ---- appended in ABI 1.1 ---- */
+  /* [out: rolling] the rolling spring and dashpot constants of each contact,
+   * k_theta [N m/rad] and n_theta [N m s/rad], for the host's rotational
+   * time-step check (docs/physics.md §3.6). Zeroed by the host before the
+   * rolling stage; a model without a spring or dashpot leaves them 0. */
+  double* rolling_stiffness;
+  double* rolling_damping;
 } domel_contact_batch_v1;
 
 /** An insertion region. shape 1: box [lo, hi]. shape 2: cylinder with the

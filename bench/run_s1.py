@@ -1,0 +1,496 @@
+#!/usr/bin/env python3
+"""Run the S1 'settle' throughput benchmark: domel against LIGGGHTS, interleaved, on this machine, now.
+
+What is measured (see docs/benchmarks.md and ../shared/peers/RESULTS.md):
+  S1 = a simple-cubic lattice column of N spheres compacting under gravity in a box (Hertz-Mindlin,
+  d = 2.8 mm, dt = 1e-5 s, skin 0.5 d). Each run does 2000 untimed steps from the lattice, then 2000 timed
+  steps; the number is particle-steps per wall-clock second of the timed steps only:
+    domel:    `domel run bench/scenarios/s1_settle_<N>.json --time-after 2000` -> summary.json "timed_window"
+    LIGGGHTS: the peers' deck (settle.in, RF none) -> N_actual * 2000 / 'Loop time' of the run after the
+              BENCHMARK_TIMED_RUN_START marker (exactly as ../shared/peers/run_peers.sh computes it).
+  Both codes run serially (one process, OMP_NUM_THREADS=1). For each N the runs alternate
+  domel, LIGGGHTS, domel, LIGGGHTS, ... so that slow drifts of the machine's load hit both codes alike.
+
+Recorded per run (CSV in bench/results/s1_<timestamp>.csv): code, N requested/actual, rep, timed wall,
+particle-steps/s, whole-process wall and CPU seconds, 1-min load average at start and end, the CPU seconds of
+the timed steps (LIGGGHTS: the deck's cpusec.sh lines; domel: sampled from /proc/<pid>/stat, the CPU the
+process used in its last timed_wall_s seconds, since the timed steps end the run) and particle-steps per
+CPU-second, and as a check that both codes did the same physics the mean particle-particle contacts per
+particle at the end (domel: 2 * contacts / particles from summary.json; LIGGGHTS: CONTACTINFO zmean), the
+translational kinetic energy at step 4000 and the neighbour-list builds.
+The printed tables give medians [min-max] per code and the domel/LIGGGHTS ratio of the medians, per
+wall-clock second (the benchmark number) and per CPU-second (the cross-check when the machine is loaded).
+
+Usage:
+    python3 bench/run_s1.py                       # N = 10000 50000, 3 reps, with LIGGGHTS if on PATH
+    python3 bench/run_s1.py --sizes 10000 50000 --reps 3 --with-200k
+    python3 bench/run_s1.py --quick               # N = 10000, 1 rep (smoke test)
+    python3 bench/run_s1.py --no-peer             # domel only
+    python3 bench/run_s1.py --report bench/results/s1_<timestamp>.csv   # re-print the tables of a run
+Exit status: 0 when every run succeeded, 1 when any failed (all other runs are still done), 2 on bad usage.
+Only the Python standard library is used. The machine's load matters: on a shared machine, read the load
+column and the per-CPU-second table before trusting a number.
+"""
+
+import argparse
+import csv
+import json
+import os
+import platform
+import re
+import resource
+import shutil
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import make_s1  # noqa: E402  (same folder)
+
+NSETTLE = make_s1.NSETTLE
+NRUN = make_s1.NRUN
+
+CSV_FIELDS = [
+    "timestamp", "code", "N_requested", "N_actual", "rep", "ok", "timed_steps", "timed_wall_s",
+    "particle_steps_per_s", "process_wall_s", "process_cpu_s", "timed_cpu_s", "particle_steps_per_cpu_s",
+    "load1_start", "load1_end", "mean_contacts_per_particle", "ke_translational_final_J", "neighbor_builds_total",
+    "error", "log",
+]
+
+
+def default_domel():
+    for rel in ("build-bench/bin/domel", "build/bin/domel"):
+        p = os.path.join(ROOT, rel)
+        if os.access(p, os.X_OK):
+            return p
+    return shutil.which("domel")
+
+
+def default_peers():
+    for p in (os.path.join(ROOT, "..", "shared", "peers"), "/work/shared/peers"):
+        if os.path.isfile(os.path.join(p, "liggghts", "settle.in")):
+            return os.path.abspath(p)
+    return None
+
+
+def machine_info():
+    model = "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return {"host": socket.gethostname(), "nproc": os.cpu_count(), "cpu": model,
+            "python": platform.python_version()}
+
+
+def load1():
+    try:
+        return os.getloadavg()[0]
+    except OSError:
+        return float("nan")
+
+
+def proc_cpu_seconds(pid, tck=os.sysconf("SC_CLK_TCK")):
+    """utime + stime of a running process from /proc (clock-tick resolution), or None."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / tck
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def run_timed(cmd, cwd, stdout_path, timeout, env, sample_s=0.02):
+    """Run cmd; return (returncode, wall seconds, CPU seconds user+sys of the child, samples).
+
+    samples: [(seconds since start, CPU seconds of the child)] read from /proc every sample_s, ending with
+    (wall at exit, total CPU from getrusage), so that the CPU time of a window that ends when the process
+    ends (domel's timed steps) can be read off: see cpu_in_last().
+    """
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.monotonic()
+    samples = []
+    with open(stdout_path, "w") as out:
+        try:
+            proc = subprocess.Popen(cmd, cwd=cwd, stdout=out, stderr=subprocess.STDOUT, env=env)
+        except OSError as exc:
+            out.write("could not start %s: %s\n" % (cmd[0], exc))
+            return 127, 0.0, 0.0, samples
+        killed = False
+        while proc.poll() is None:
+            now = time.monotonic() - t0
+            if now > timeout:
+                proc.kill()
+                proc.wait()
+                killed = True
+                break
+            c = proc_cpu_seconds(proc.pid)
+            if c is not None:
+                samples.append((now, c))
+            time.sleep(sample_s)
+        rc = 124 if killed else proc.returncode
+    wall = time.monotonic() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    samples.append((wall, cpu))
+    return rc, wall, cpu, samples
+
+
+def cpu_in_last(samples, window_s):
+    """CPU seconds used in the last window_s of the run (linear interpolation between samples)."""
+    if len(samples) < 2:
+        return None
+    t_end, c_end = samples[-1]
+    t0 = t_end - window_s
+    if t0 <= samples[0][0]:
+        return None
+    for (ta, ca), (tb, cb) in zip(samples, samples[1:]):
+        if ta <= t0 <= tb:
+            c0 = ca + (cb - ca) * ((t0 - ta) / (tb - ta) if tb > ta else 0.0)
+            return c_end - c0
+    return None
+
+
+def scenario_file(n, workdir):
+    """The committed bench/scenarios file for N when it exists and matches make_s1.py, else a fresh one."""
+    committed = os.path.join(HERE, "scenarios", "s1_settle_%s.json" % make_s1.label(n))
+    fresh = make_s1.scenario(n)
+    if os.path.isfile(committed):
+        with open(committed) as f:
+            if json.load(f) == fresh:
+                return committed
+        print("warning: %s differs from make_s1.py's output; using a regenerated copy" % committed,
+              file=sys.stderr)
+    path = os.path.join(workdir, "s1_settle_%s.json" % make_s1.label(n))
+    with open(path, "w") as f:
+        f.write(make_s1.dumps(fresh) + "\n")
+    return path
+
+
+def run_domel(domel, n, rep, workdir, timeout, env):
+    nx, ny, nz = make_s1.lattice_dims(n)
+    expected = nx * ny * nz
+    outdir = os.path.join(workdir, "domel_N%d_r%d" % (n, rep))
+    log = outdir + ".screen"
+    row = {"code": "domel", "N_requested": n, "rep": rep, "log": log}
+    row["load1_start"] = load1()
+    rc, wall, cpu, samples = run_timed([domel, "run", scenario_file(n, workdir), "--out", outdir, "--quiet",
+                               "--time-after", str(NSETTLE)], workdir, log, timeout, env)
+    row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)
+    summary_path = os.path.join(outdir, "summary.json")
+    if rc != 0 or not os.path.isfile(summary_path):
+        row.update(ok=0, error="domel exit %d (see %s)" % (rc, log))
+        return row
+    with open(summary_path) as f:
+        s = json.load(f)
+    tw = s.get("timed_window")
+    if not tw:
+        row.update(ok=0, error="summary.json has no timed_window")
+        return row
+    row.update(N_actual=s.get("particles"), timed_steps=tw.get("steps"), timed_wall_s=tw.get("wall_time_s"),
+               particle_steps_per_s=tw.get("particle_steps_per_s"))
+    sds = s.get("subdomains") or []
+    if sds:
+        sd = sds[0]
+        fin = sd.get("final", {})
+        if "contacts" in fin and sd.get("particles"):
+            row["mean_contacts_per_particle"] = 2.0 * fin["contacts"] / sd["particles"]
+        row["ke_translational_final_J"] = fin.get("ke_translational_J")
+        row["neighbor_builds_total"] = sd.get("neighbor_list_builds")
+    # domel has no CPU clock of its own around the timed steps: they are the last steps of the process, so
+    # take the CPU time the process used in its last timed_wall_s seconds (sampled from /proc every 20 ms;
+    # includes the few ms of summary writing and exit)
+    tcpu = cpu_in_last(samples, row["timed_wall_s"] or 0.0)
+    if tcpu:
+        row["timed_cpu_s"] = tcpu
+        row["particle_steps_per_cpu_s"] = row["N_actual"] * row["timed_steps"] / tcpu
+    if row["N_actual"] != expected:
+        row.update(ok=0, error="N_actual %s != %d (lattice %dx%dx%d)" % (row["N_actual"], expected, nx, ny, nz))
+    elif row["timed_steps"] != NRUN:
+        row.update(ok=0, error="timed window has %s steps, expected %d" % (row["timed_steps"], NRUN))
+    else:
+        row["ok"] = 1
+    return row
+
+
+def parse_liggghts(text):
+    """Numbers from a LIGGGHTS settle.in screen: as in ../shared/peers/run_peers.sh."""
+    res = {}
+    m = re.search(r"BENCHINFO code=\S+ N=(\d+)", text)
+    if m:
+        res["N_actual"] = int(m.group(1))
+    marker = text.find("BENCHMARK_TIMED_RUN_START")
+    if marker >= 0:
+        m = re.search(r"^Loop time of (\S+) on \d+ procs for (\d+) steps", text[marker:], re.M)
+        if m:
+            res["timed_wall_s"] = float(m.group(1))
+            res["timed_steps"] = int(m.group(2))
+    # thermo rows 'step atoms ke x' (thermo_modify norm no: total translational KE); keep the last at the end
+    final = NSETTLE + NRUN
+    for m in re.finditer(r"^\s*(\d+)\s+\d+\s+([-+0-9.eE]+)\s+[-+0-9.eE]+\s*$", text, re.M):
+        if int(m.group(1)) == final:
+            res["ke_translational_final_J"] = float(m.group(2))
+    m = re.search(r"CONTACTINFO zmean=(\S+)", text)
+    if m:
+        res["mean_contacts_per_particle"] = float(m.group(1))
+    # 'shell' output can land mid-line in LIGGGHTS' buffered screen (RESULTS.md, deck problem 7)
+    cpus = [float(v) for v in re.findall(r"CPUSECONDS ([0-9.]+)", text)]
+    if len(cpus) >= 2:
+        res["timed_cpu_s"] = cpus[1] - cpus[0]
+    builds = [int(v) for v in re.findall(r"^Neighbor list builds = (\d+)", text, re.M)]
+    if builds:
+        res["neighbor_builds_total"] = sum(builds)
+    return res
+
+
+def run_liggghts(liggghts, deckdir, n, rep, workdir, timeout, env):
+    tag = "liggghts_N%d_r%d" % (n, rep)
+    log, screen = os.path.join(workdir, tag + ".log"), os.path.join(workdir, tag + ".screen")
+    row = {"code": "liggghts", "N_requested": n, "rep": rep, "log": screen}
+    cmd = [liggghts, "-in", "settle.in", "-var", "N", str(n), "-var", "nsettle", str(NSETTLE),
+           "-var", "nrun", str(NRUN), "-var", "RF", "none", "-log", log]
+    if shutil.which("stdbuf"):  # LIGGGHTS dies silently when stdout is a file (RESULTS.md, problem 2)
+        cmd = ["stdbuf", "-oL"] + cmd
+    row["load1_start"] = load1()
+    rc, wall, cpu, _ = run_timed(cmd, deckdir, screen, timeout, env)
+    row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)
+    with open(screen, errors="replace") as f:
+        row.update(parse_liggghts(f.read()))
+    if rc != 0 or "timed_wall_s" not in row or "N_actual" not in row:
+        row.update(ok=0, error="liggghts exit %d, timed Loop time %s (see %s)"
+                   % (rc, "found" if "timed_wall_s" in row else "missing", screen))
+        return row
+    row["particle_steps_per_s"] = row["N_actual"] * row["timed_steps"] / row["timed_wall_s"]
+    if row.get("timed_cpu_s"):
+        row["particle_steps_per_cpu_s"] = row["N_actual"] * row["timed_steps"] / row["timed_cpu_s"]
+    row["ok"] = 1
+    return row
+
+
+def stats(values):
+    v = [x for x in values if isinstance(x, (int, float))]
+    if not v:
+        return None
+    return statistics.median(v), min(v), max(v)
+
+
+def fmt_rate(st):
+    if st is None:
+        return "-"
+    return "%.2e [%.2e-%.2e]" % st
+
+
+def print_tables(rows, sizes, have_peer):
+    print()
+    head = ["N", "domel median [min-max]", "LIGGGHTS median [min-max]", "ratio domel/LIGGGHTS", "load"]
+    lines = []
+    for n in sizes:
+        mine = [r for r in rows if r["N_requested"] == n]
+        nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), n)
+        d = stats([r.get("particle_steps_per_s") for r in mine if r["code"] == "domel" and r.get("ok")])
+        p = stats([r.get("particle_steps_per_s") for r in mine if r["code"] == "liggghts" and r.get("ok")])
+        ratio = "%.2f" % (d[0] / p[0]) if d and p else "-"
+        loads = [r["load1_start"] for r in mine if isinstance(r.get("load1_start"), float)]
+        load = "%.2f-%.2f" % (min(loads), max(loads)) if loads else "-"
+        nd = sum(1 for r in mine if r["code"] == "domel" and r.get("ok"))
+        np_ = sum(1 for r in mine if r["code"] == "liggghts" and r.get("ok"))
+        lines.append([str(nact), fmt_rate(d) + " (%d)" % nd,
+                      (fmt_rate(p) + " (%d)" % np_) if have_peer else "not run", ratio, load])
+    print("S1 settle, timed particle-steps/s (2000 steps after 2000 untimed); (runs); "
+          "load = 1-min load average at the start of the runs")
+    print_md(head, lines)
+
+    print()
+    print("Per CPU-second of the timed steps (robust to time-slicing on a loaded machine): LIGGGHTS from the "
+          "deck's cpusec.sh lines, domel from /proc samples of its last timed_wall seconds; "
+          "cpu/wall = share of a core the runs got")
+    head = ["N", "domel median [min-max]", "LIGGGHTS median [min-max]", "ratio domel/LIGGGHTS", "cpu/wall"]
+    lines = []
+    for n in sizes:
+        mine = [r for r in rows if r["N_requested"] == n and r.get("ok")]
+        nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), n)
+        d = stats([r.get("particle_steps_per_cpu_s") for r in mine if r["code"] == "domel"])
+        p = stats([r.get("particle_steps_per_cpu_s") for r in mine if r["code"] == "liggghts"])
+        ratio = "%.2f" % (d[0] / p[0]) if d and p else "-"
+        shares = [r["timed_cpu_s"] / r["timed_wall_s"] for r in mine
+                  if r.get("timed_cpu_s") and r.get("timed_wall_s")]
+        share = "%.2f-%.2f" % (min(shares), max(shares)) if shares else "-"
+        lines.append([str(nact), fmt_rate(d), fmt_rate(p) if have_peer else "not run", ratio, share])
+    print_md(head, lines)
+
+    print()
+    print("Sanity check (same physics?): mean particle-particle contacts per particle and translational KE at "
+          "step 4000 (medians over runs), neighbour-list builds in 4000 steps (domel counts its initial build, "
+          "LIGGGHTS does not); a single jitter seed scatters by several %, see docs/benchmarks.md")
+    head = ["N", "domel contacts/particle", "LIGGGHTS zmean", "difference", "KE domel/LIGGGHTS",
+            "domel builds", "LIGGGHTS builds"]
+    lines = []
+    for n in sizes:
+        mine = [r for r in rows if r["N_requested"] == n and r.get("ok")]
+        nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), n)
+        zd = stats([r.get("mean_contacts_per_particle") for r in mine if r["code"] == "domel"])
+        zp = stats([r.get("mean_contacts_per_particle") for r in mine if r["code"] == "liggghts"])
+        bd = stats([r.get("neighbor_builds_total") for r in mine if r["code"] == "domel"])
+        bp = stats([r.get("neighbor_builds_total") for r in mine if r["code"] == "liggghts"])
+        kd = stats([r.get("ke_translational_final_J") for r in mine if r["code"] == "domel"])
+        kp = stats([r.get("ke_translational_final_J") for r in mine if r["code"] == "liggghts"])
+        diff = "%+.1f %%" % (100.0 * (zd[0] / zp[0] - 1.0)) if zd and zp and zp[0] else "-"
+        kratio = "%.3f" % (kd[0] / kp[0]) if kd and kp and kp[0] else "-"
+        lines.append([str(nact), "%.3f" % zd[0] if zd else "-", "%.3f" % zp[0] if zp else "-", diff, kratio,
+                      "%g" % bd[0] if bd else "-", "%g" % bp[0] if bp else "-"])
+    print_md(head, lines)
+
+
+def print_md(head, lines):
+    widths = [max(len(head[i]), *(len(l[i]) for l in lines)) if lines else len(head[i]) for i in range(len(head))]
+    print("| " + " | ".join(h.ljust(w) for h, w in zip(head, widths)) + " |")
+    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+    for l in lines:
+        print("| " + " | ".join(c.ljust(w) for c, w in zip(l, widths)) + " |")
+
+
+def fmt_csv(v):
+    if isinstance(v, float):
+        return "%.6g" % v
+    return "" if v is None else v
+
+
+def report(csv_path):
+    """Re-print the tables from a CSV written by an earlier run."""
+    num = {"N_requested", "N_actual", "rep", "ok", "timed_steps", "neighbor_builds_total"}
+    rows = []
+    with open(csv_path, newline="") as f:
+        for r in csv.DictReader(f):
+            row = {}
+            for k, v in r.items():
+                if v == "" or k in ("timestamp", "code", "error", "log"):
+                    row[k] = v if v != "" else None
+                else:
+                    try:
+                        row[k] = int(v) if k in num else float(v)
+                    except ValueError:
+                        row[k] = v
+            rows.append(row)
+    sizes = []
+    for r in rows:
+        if r["N_requested"] not in sizes:
+            sizes.append(r["N_requested"])
+    print("S1 settle results from %s" % csv_path)
+    print_tables(rows, sizes, any(r["code"] == "liggghts" for r in rows))
+    return 0 if all(r.get("ok") for r in rows) else 1
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="S1 settle throughput: domel vs LIGGGHTS, interleaved.")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[10000, 50000], help="requested N (default 10000 50000)")
+    ap.add_argument("--with-200k", action="store_true", help="also run N = 200000 (~2.5 min per run per code)")
+    ap.add_argument("--reps", type=int, default=3, help="runs per code and N (default 3)")
+    ap.add_argument("--quick", action="store_true", help="smoke test: N = 10000, 1 rep")
+    ap.add_argument("--no-peer", action="store_true", help="do not run LIGGGHTS")
+    ap.add_argument("--domel", default=default_domel(),
+                    help="domel binary (default build-bench/bin/domel, else build/bin/domel, else PATH)")
+    ap.add_argument("--liggghts", default=shutil.which("liggghts"), help="LIGGGHTS binary (default: on PATH)")
+    ap.add_argument("--peers", default=default_peers(), help="peers folder with liggghts/settle.in and cpusec.sh")
+    ap.add_argument("--timeout", type=float, default=900, help="per-run timeout in s (default 900)")
+    ap.add_argument("--results", default=os.path.join(HERE, "results"), help="CSV folder (default bench/results)")
+    ap.add_argument("--report", metavar="CSV", help="only print the tables of an earlier run's CSV, run nothing")
+    ap.add_argument("--workdir", help="where logs and domel outputs go (default: a fresh temp dir, kept)")
+    args = ap.parse_args(argv)
+
+    if args.report:
+        return report(args.report)
+
+    sizes = [10000] if args.quick else list(args.sizes)
+    reps = 1 if args.quick else args.reps
+    if args.with_200k and 200000 not in sizes:
+        sizes.append(200000)
+    if reps < 1 or any(n < 2 for n in sizes):
+        ap.error("--reps must be >= 1 and every size >= 2")
+    if not args.domel or not os.access(args.domel, os.X_OK):
+        ap.error("no domel binary (build it: cmake -S . -B build-bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
+                 "-DDOMEL_BUILD_TESTS=OFF && cmake --build build-bench), or pass --domel")
+    have_peer = not args.no_peer and bool(args.liggghts)
+    if have_peer and not args.peers:
+        print("warning: liggghts found but no peers folder with liggghts/settle.in; LIGGGHTS not run",
+              file=sys.stderr)
+        have_peer = False
+    if not args.no_peer and not args.liggghts:
+        print("note: liggghts is not on PATH; running domel only", file=sys.stderr)
+
+    stamp = time.strftime("%Y%m%dT%H%M%S")
+    workdir = os.path.abspath(args.workdir or tempfile.mkdtemp(prefix="domel_s1_%s_" % stamp))
+    os.makedirs(workdir, exist_ok=True)
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    deckdir = None
+    if have_peer:
+        # the deck calls `shell ../cpusec.sh`: copy liggghts/ and cpusec.sh keeping that layout (never write
+        # into the shared peers folder)
+        peer_copy = os.path.join(workdir, "peers")
+        shutil.copytree(os.path.join(args.peers, "liggghts"), os.path.join(peer_copy, "liggghts"), dirs_exist_ok=True)
+        shutil.copy2(os.path.join(args.peers, "cpusec.sh"), os.path.join(peer_copy, "cpusec.sh"))
+        deckdir = os.path.join(peer_copy, "liggghts")
+
+    info = machine_info()
+    print("S1 settle benchmark %s on %s: %s cores, %s; load average %s" % (
+        stamp, info["host"], info["nproc"], info["cpu"], " ".join("%.2f" % x for x in os.getloadavg())))
+    print("domel: %s" % args.domel)
+    print("LIGGGHTS: %s" % (("%s, deck %s (copied to %s)" % (args.liggghts, os.path.join(args.peers, "liggghts"),
+                                                                 deckdir)) if have_peer else "not run"))
+    print("sizes %s, %d rep(s), logs in %s" % (" ".join(map(str, sizes)), reps, workdir))
+    print()
+
+    os.makedirs(args.results, exist_ok=True)
+    csv_path = os.path.join(args.results, "s1_%s.csv" % stamp)
+    rows = []
+    with open(csv_path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=CSV_FIELDS)
+        w.writeheader()
+        for n in sizes:
+            for rep in range(1, reps + 1):
+                jobs = [("domel", lambda: run_domel(args.domel, n, rep, workdir, args.timeout, env))]
+                if have_peer:
+                    jobs.append(("liggghts", lambda: run_liggghts(args.liggghts, deckdir, n, rep, workdir,
+                                                                  args.timeout, env)))
+                for _, job in jobs:
+                    row = job()
+                    row["timestamp"] = time.strftime("%Y-%m-%dT%H:%M:%S")
+                    rows.append(row)
+                    w.writerow({k: fmt_csv(row.get(k)) for k in CSV_FIELDS})
+                    f.flush()
+                    if row.get("ok"):
+                        extra = ""
+                        if row.get("timed_cpu_s"):
+                            extra = ", cpu %.2f s -> %.4g per cpu-s" % (row["timed_cpu_s"],
+                                                                        row["particle_steps_per_cpu_s"])
+                        print("%-8s N=%-6s rep %d: %.4g particle-steps/s (timed %.2f s%s; process %.1f s wall, "
+                              "%.1f s cpu; contacts/particle %s; load %.2f -> %.2f)" % (
+                                  row["code"], row["N_actual"], rep, row["particle_steps_per_s"],
+                                  row["timed_wall_s"], extra, row["process_wall_s"], row["process_cpu_s"],
+                                  ("%.3f" % row["mean_contacts_per_particle"])
+                                  if row.get("mean_contacts_per_particle") is not None else "-",
+                                  row["load1_start"], row["load1_end"]), flush=True)
+                    else:
+                        print("%-8s N=%-6s rep %d: FAILED: %s" % (row["code"], n, rep, row.get("error")),
+                              flush=True)
+
+    print_tables(rows, sizes, have_peer)
+    print()
+    print("CSV: %s" % csv_path)
+    failed = [r for r in rows if not r.get("ok")]
+    if failed:
+        print("%d run(s) failed" % len(failed), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

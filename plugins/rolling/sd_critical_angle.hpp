@@ -1,0 +1,113 @@
+// SPDX-License-Identifier: MIT
+// Rolling slot "sd_critical_angle": the single-parameter spring–dashpot
+// rolling model (Widartiningsih et al. 2026, arXiv 2602.15887, as
+// reconstructed in docs/physics.md §3; all [RECON]). One parameter, the
+// critical rolling angle theta_c, fixes everything from the contact's own
+// R*, k_n, eta_n and F_n:
+//   a     = R* tan(theta_c)                 moment arm, from the incline balance (§3.1)
+//   k_th  = k_n a^2 / 4                     spring bed over a disk of radius a (§2.6, §3.3)
+//   n_th  = eta_n a^2 / 4                   dashpot bed, same integral (§3.3)
+//   M_ref = R* tan(theta_c) |F_n,el|        torque cap (§3.2)
+// Incremental law (§3.4): the stored rolling angle theta_r is projected onto
+// the current tangent plane (its length kept), theta_r += omega_r dt,
+// M_s = -k_th theta_r; above the cap M_s is scaled to M_ref and theta_r
+// rescaled so that k_th |theta_r| = M_ref (plastic slip); M = M_s + M_d with
+// M_d = -n_th omega_r while elastic.
+// Choices the sources leave open (docs/rolling.md):
+//  - k_n is the TANGENT normal stiffness dF/d delta by default (the incremental
+//    stiffness a small tilt actually meets; 1.5x the secant one for Hertz);
+//    "normal_stiffness": "secant" selects F/delta.
+//  - the dashpot is OFF once the spring is fully mobilised (Ai et al. 2011's
+//    f = 0, as LIGGGHTS epsd); "damping_at_yield": true keeps it.
+// History: 3 doubles, the rolling angle vector theta_r [rad].
+// Because everything scales with the parcel's own R*, k_n and F_n, theta_c
+// is preserved under coarse-graining (§3.7, "implementation recommendation").
+#pragma once
+
+#include "rolling_common.hpp"
+
+#include <domel/sdk/plugin.hpp>
+
+#include <cmath>
+
+namespace domel::plugins::rolling {
+
+class SdCriticalAngle {
+ public:
+  static constexpr domel_kind kKind = DOMEL_KIND_ROLLING;
+  static constexpr const char* kName = "sd_critical_angle";
+  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kSummary =
+      "single-parameter spring-dashpot rolling resistance from the critical rolling angle theta_c";
+  static constexpr unsigned kHistorySlots = 3;
+  static constexpr const char* kSchema = R"json({
+  "type": "object",
+  "description": "Spring-dashpot rolling resistance with one physical parameter, the critical rolling angle: the steepest incline on which a sphere stays at rest. Stiffness, damping and torque cap follow from it and the normal contact.",
+  "properties": {
+    "critical_angle": { "type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 90, "x-unit": "deg",
+                        "description": "critical rolling angle theta_c" },
+    "normal_stiffness": { "enum": ["tangent", "secant"], "default": "tangent",
+                          "description": "which normal stiffness k_n sets k_theta = k_n a^2/4: tangent dF/d(delta) or secant F/delta (equal for a linear spring)" },
+    "damping_at_yield": { "type": "boolean", "default": false,
+                          "description": "keep the rolling dashpot while the spring is fully mobilised (default: off, Ai et al. 2011)" }
+  },
+  "required": ["critical_angle"],
+  "additionalProperties": false
+})json";
+
+  explicit SdCriticalAngle(const sdk::Params& p)
+      : tan_c_(std::tan(p.number("critical_angle") * M_PI / 180.0)),
+        tangent_(p.string_or("normal_stiffness", "tangent") == "tangent"),
+        damping_at_yield_(p.boolean_or("damping_at_yield", false)) {
+    const double deg = p.number("critical_angle");
+    if (!(deg > 0.0 && deg < 90.0))
+      throw sdk::ParameterError("sd_critical_angle: critical_angle must lie in (0, 90) degrees");
+  }
+
+  void compute(domel_contact_batch_v1& b) const {
+    const uint32_t s = b.history_stride;
+    for (uint32_t c = 0; c < b.n; ++c) {
+      double* th = b.history + static_cast<size_t>(c) * s;
+      const double a = b.r_eff[c] * tan_c_;
+      const double kn = tangent_ ? b.kn_tangent[c] : b.kn[c];
+      const double k = 0.25 * kn * a * a;
+      const double eta = 0.25 * b.eta_n[c] * a * a;
+      const double m_ref = a * cap_force(b, c);
+      const Vec3 w = rolling_velocity(b, c);
+      // rotate the stored angle into the current tangent plane, keeping its length
+      const double len0 = std::sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+      const double proj = th[0] * b.nx[c] + th[1] * b.ny[c] + th[2] * b.nz[c];
+      double t0 = th[0] - proj * b.nx[c], t1 = th[1] - proj * b.ny[c], t2 = th[2] - proj * b.nz[c];
+      const double len1 = std::sqrt(t0 * t0 + t1 * t1 + t2 * t2);
+      if (len1 > 0.0) {
+        const double keep = len0 / len1;
+        t0 *= keep; t1 *= keep; t2 *= keep;
+      }
+      t0 += w.x * b.dt; t1 += w.y * b.dt; t2 += w.z * b.dt;
+      double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
+      const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
+      bool yielded = false;
+      if (ms > m_ref) {
+        const double scale = ms > 0.0 ? m_ref / ms : 0.0;
+        m0 *= scale; m1 *= scale; m2 *= scale;
+        if (k > 0.0) { t0 = -m0 / k; t1 = -m1 / k; t2 = -m2 / k; }
+        else { t0 = t1 = t2 = 0.0; }
+        yielded = true;
+      }
+      if (!yielded || damping_at_yield_) {
+        m0 -= eta * w.x; m1 -= eta * w.y; m2 -= eta * w.z;
+      }
+      th[0] = t0; th[1] = t1; th[2] = t2;
+      b.tqx[c] += m0; b.tqy[c] += m1; b.tqz[c] += m2;
+      b.rolling_stiffness[c] = k;
+      b.rolling_damping[c] = eta;
+    }
+  }
+
+ private:
+  double tan_c_;
+  bool tangent_;
+  bool damping_at_yield_;
+};
+
+}  // namespace domel::plugins::rolling
