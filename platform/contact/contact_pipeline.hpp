@@ -5,9 +5,11 @@
 // as LAMMPS' granular sub-models are (style.md). Each slot owns a slice of
 // the per-contact history; the pipeline lays the slices out in one stride.
 //
-// Callers fill the input arrays of `batch()` for up to kBatchSize contacts
-// (and their history rows), call evaluate(n), then read fn and the
-// tangential force and torque outputs.
+// Callers fill the input arrays of a Workspace for up to kBatchSize contacts
+// (and their history rows), call evaluate(workspace, pair, dt, n), then read
+// fn and the tangential force and torque outputs. The slot instances are
+// shared; each thread uses its own Workspace (kernels may run concurrently
+// on one instance, see abi.h).
 #pragma once
 
 #include "loader/plugin_registry.hpp"
@@ -40,18 +42,29 @@ class ContactPipeline {
     std::vector<double> rolling_stiffness, rolling_damping;
     std::vector<double> history;  ///< kBatchSize * history_stride
   };
-  Buffers& buffers() { return buf_; }
-  const Buffers& buffers() const { return buf_; }
+  /// One thread's batch buffers and the ABI view of them.
+  class Workspace {
+   public:
+    explicit Workspace(uint32_t history_stride);
+    Workspace(const Workspace&) = delete;
+    Workspace& operator=(const Workspace&) = delete;
+    Buffers buf;
+    domel_contact_batch_v1 batch{};
+  };
+  std::unique_ptr<Workspace> make_workspace() const { return std::make_unique<Workspace>(history_stride_); }
 
-  /// Evaluate all stages on the first n contacts of the buffers.
-  void evaluate(const domel_pair_v1& pair, double dt, uint32_t n);
+  /// Evaluate all stages on the first n contacts of a workspace.
+  void evaluate(Workspace& ws, const domel_pair_v1& pair, double dt, uint32_t n) const;
+
+  /// The pipeline's own workspace, for single-threaded callers.
+  Buffers& buffers() { return main_->buf; }
+  void evaluate(const domel_pair_v1& pair, double dt, uint32_t n) { evaluate(*main_, pair, dt, n); }
 
  private:
   std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots_;
   std::array<uint32_t, kSlotCount> offset_{};
   uint32_t history_stride_ = 0;
-  Buffers buf_;
-  domel_contact_batch_v1 batch_{};
+  std::unique_ptr<Workspace> main_;
 };
 
 }  // namespace domel::platform

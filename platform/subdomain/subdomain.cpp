@@ -22,9 +22,19 @@ namespace domel::platform {
 Subdomain::Subdomain(std::string name, double coarse_grain, std::size_t material,
                      std::unique_ptr<ContactPipeline> pipeline)
     : name_(std::move(name)), coarse_grain_(coarse_grain), material_(material), pipeline_(std::move(pipeline)) {
-  batch_entry_.resize(ContactPipeline::kBatchSize);
-  batch_ci_.resize(ContactPipeline::kBatchSize);
-  batch_cj_.resize(ContactPipeline::kBatchSize);
+  set_threads(1);
+}
+
+void Subdomain::set_threads(int threads) {
+  pool_ = std::make_unique<ThreadPool>(threads);
+  scratch_.clear();
+  scratch_.resize(static_cast<std::size_t>(std::max(1, threads)));
+  for (auto& ts : scratch_) {
+    ts.ws = pipeline_->make_workspace();
+    ts.entry.resize(ContactPipeline::kBatchSize);
+    ts.ci.resize(ContactPipeline::kBatchSize);
+    ts.cj.resize(ContactPipeline::kBatchSize);
+  }
 }
 
 void Subdomain::set_environment(const std::vector<Material>& materials,
@@ -149,21 +159,28 @@ void Subdomain::step() {
   const std::size_t n = store_.size();
   const double dt = dt_, half = 0.5 * dt_;
   ParticleStore& s = store_;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
-    s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
-    s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
-    s.x[k] += dt * s.vx[k]; s.y[k] += dt * s.vy[k]; s.z[k] += dt * s.vz[k];
-  }
+  pool_->for_range(n, [&](std::size_t first, std::size_t last, int) {
+    for (std::size_t k = first; k < last; ++k) {
+      const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
+      s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
+      s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
+      s.x[k] += dt * s.vx[k]; s.y[k] += dt * s.vy[k]; s.z[k] += dt * s.vz[k];
+    }
+  });
   if (nlist_.needs_rebuild(s)) rebuild_lists();
   compute_forces();
-  bool finite = true;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
-    s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
-    s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
-    finite &= std::isfinite(s.x[k] + s.y[k] + s.z[k] + s.vx[k] + s.vy[k] + s.vz[k]);
-  }
+  std::vector<char> finite_part(static_cast<std::size_t>(threads()), 1);
+  pool_->for_range(n, [&](std::size_t first, std::size_t last, int t) {
+    bool ok = true;
+    for (std::size_t k = first; k < last; ++k) {
+      const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
+      s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
+      s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
+      ok = ok && std::isfinite(s.x[k] + s.y[k] + s.z[k] + s.vx[k] + s.vy[k] + s.vz[k]);
+    }
+    finite_part[static_cast<std::size_t>(t)] = ok;
+  });
+  const bool finite = std::all_of(finite_part.begin(), finite_part.end(), [](char c) { return c != 0; });
   time_ += dt;
   ++steps_;
   if (!finite) {
@@ -176,14 +193,15 @@ void Subdomain::step() {
 
 void Subdomain::compute_forces() {
   ParticleStore& s = store_;
-  const std::size_t n = s.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    s.fx[k] = s.mass[k] * gravity_[0];
-    s.fy[k] = s.mass[k] * gravity_[1];
-    s.fz[k] = s.mass[k] * gravity_[2];
-    s.tx[k] = s.ty[k] = s.tz[k] = 0.0;
-    s.contacts[k] = 0;
-  }
+  pool_->for_range(s.size(), [&](std::size_t first, std::size_t last, int) {
+    for (std::size_t k = first; k < last; ++k) {
+      s.fx[k] = s.mass[k] * gravity_[0];
+      s.fy[k] = s.mass[k] * gravity_[1];
+      s.fz[k] = s.mass[k] * gravity_[2];
+      s.tx[k] = s.ty[k] = s.tz[k] = 0.0;
+      s.contacts[k] = 0;
+    }
+  });
   last_max_overlap_ratio_ = 0;
   pair_forces();
   wall_forces();
@@ -191,39 +209,81 @@ void Subdomain::compute_forces() {
 
 void Subdomain::pair_forces() {
   ParticleStore& s = store_;
-  auto& buf = pipeline_->buffers();
-  const uint32_t stride = nlist_.stride();
   const std::size_t npairs = nlist_.size();
+  const int nt = threads();
+  const Accumulator direct{s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data(),
+                           s.contacts.data()};
+  if (nt == 1) {
+    pair_range(0, npairs, scratch_[0], direct);
+  } else {
+    // Each thread owns a fixed, contiguous range of the pair list (so each
+    // list entry and its history has one writer). Thread 0 adds into the
+    // store; the others into their own arrays, summed below in thread order:
+    // the same floating-point sums every run for a given thread count.
+    const std::size_t n = s.size();
+    pool_->run([&](int t) {
+      ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+      Accumulator acc = direct;
+      if (t > 0) {
+        for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) v->assign(n, 0.0);
+        ts.contacts.assign(n, 0);
+        acc = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data(),
+               ts.contacts.data()};
+      }
+      const auto r = pool_->range(npairs, t);
+      pair_range(r.first, r.second, ts, acc);
+    });
+    pool_->for_range(n, [&](std::size_t first, std::size_t last, int) {
+      for (std::size_t k = first; k < last; ++k)
+        for (int t = 1; t < nt; ++t) {
+          const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+          s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
+          s.tx[k] += ts.tx[k]; s.ty[k] += ts.ty[k]; s.tz[k] += ts.tz[k];
+          s.contacts[k] += ts.contacts[k];
+        }
+    });
+  }
+  last_contacts_ = 0;
+  for (const auto& ts : scratch_) {
+    last_contacts_ += ts.n_contacts;
+    last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.max_ratio);
+  }
+}
+
+void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc) {
+  const ParticleStore& s = store_;
+  auto& buf = ts.ws->buf;
+  const uint32_t stride = nlist_.stride();
   std::size_t contacts = 0;
   double max_ratio = 0.0;
   uint32_t c = 0;
 
   auto flush = [&]() {
     if (c == 0) return;
-    pipeline_->evaluate(self_pair_, dt_, c);
+    pipeline_->evaluate(*ts.ws, self_pair_, dt_, c);
     for (uint32_t q = 0; q < c; ++q) {
-      const uint32_t e = batch_entry_[q];
+      const uint32_t e = ts.entry[q];
       const uint32_t i = nlist_.i[e], j = nlist_.j[e];
       const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
       const double fn = buf.fn[q];
       const double ftx = buf.ftx[q], fty = buf.fty[q], ftz = buf.ftz[q];
       const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
-      s.fx[i] += fx; s.fy[i] += fy; s.fz[i] += fz;
-      s.fx[j] -= fx; s.fy[j] -= fy; s.fz[j] -= fz;
+      acc.fx[i] += fx; acc.fy[i] += fy; acc.fz[i] += fz;
+      acc.fx[j] -= fx; acc.fy[j] -= fy; acc.fz[j] -= fz;
       // n x F_t
       const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
-      const double ci = batch_ci_[q], cj = batch_cj_[q];
-      s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
-      s.tx[j] += -cj * cx - buf.tqx[q]; s.ty[j] += -cj * cy - buf.tqy[q]; s.tz[j] += -cj * cz - buf.tqz[q];
-      ++s.contacts[i];
-      ++s.contacts[j];
+      const double ci = ts.ci[q], cj = ts.cj[q];
+      acc.tx[i] += -ci * cx + buf.tqx[q]; acc.ty[i] += -ci * cy + buf.tqy[q]; acc.tz[i] += -ci * cz + buf.tqz[q];
+      acc.tx[j] += -cj * cx - buf.tqx[q]; acc.ty[j] += -cj * cy - buf.tqy[q]; acc.tz[j] += -cj * cz - buf.tqz[q];
+      ++acc.contacts[i];
+      ++acc.contacts[j];
       if (stride) std::copy_n(buf.history.begin() + q * stride, stride, nlist_.history.begin() + e * stride);
     }
     contacts += c;
     c = 0;
   };
 
-  for (std::size_t e = 0; e < npairs; ++e) {
+  for (std::size_t e = first; e < last; ++e) {
     const uint32_t i = nlist_.i[e], j = nlist_.j[e];
     const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
     const double rsum = s.radius[i] + s.radius[j];
@@ -260,20 +320,21 @@ void Subdomain::pair_forces() {
     buf.wx[c] = s.wx[i] - s.wx[j]; buf.wy[c] = s.wy[i] - s.wy[j]; buf.wz[c] = s.wz[i] - s.wz[j];
     if (stride) std::copy_n(nlist_.history.begin() + e * stride, stride, buf.history.begin() + c * stride);
     nlist_.touching[e] = 1;
-    batch_entry_[c] = static_cast<uint32_t>(e);
-    batch_ci_[c] = ci;
-    batch_cj_[c] = cj;
+    ts.entry[c] = static_cast<uint32_t>(e);
+    ts.ci[c] = ci;
+    ts.cj[c] = cj;
     max_ratio = std::max(max_ratio, delta / rsum);
     if (++c == ContactPipeline::kBatchSize) flush();
   }
   flush();
-  last_contacts_ = contacts;
-  last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, max_ratio);
+  ts.n_contacts = contacts;
+  ts.max_ratio = max_ratio;
 }
 
 void Subdomain::wall_forces() {
   ParticleStore& s = store_;
-  auto& buf = pipeline_->buffers();
+  ThreadScratch& ts = scratch_[0];
+  auto& buf = ts.ws->buf;
   const uint32_t stride = pipeline_->history_stride();
   std::size_t contacts = 0;
   double max_ratio = 0.0;
@@ -283,16 +344,16 @@ void Subdomain::wall_forces() {
     uint32_t c = 0;
     auto flush = [&]() {
       if (c == 0) return;
-      pipeline_->evaluate(wall_pairs_[w], dt_, c);
+      pipeline_->evaluate(*ts.ws, wall_pairs_[w], dt_, c);
       for (uint32_t q = 0; q < c; ++q) {
-        const uint32_t e = batch_entry_[q];
+        const uint32_t e = ts.entry[q];
         const uint32_t i = list.particle[e];
         const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
         const double fn = buf.fn[q];
         const double ftx = buf.ftx[q], fty = buf.fty[q], ftz = buf.ftz[q];
         s.fx[i] += fn * nx + ftx; s.fy[i] += fn * ny + fty; s.fz[i] += fn * nz + ftz;
         const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
-        const double ci = batch_ci_[q];
+        const double ci = ts.ci[q];
         s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
         ++s.contacts[i];
         if (stride) std::copy_n(buf.history.begin() + q * stride, stride, list.history.begin() + e * stride);
@@ -328,8 +389,8 @@ void Subdomain::wall_forces() {
       buf.wx[c] = s.wx[i]; buf.wy[c] = s.wy[i]; buf.wz[c] = s.wz[i];
       if (stride) std::copy_n(list.history.begin() + e * stride, stride, buf.history.begin() + c * stride);
       list.touching[e] = 1;
-      batch_entry_[c] = static_cast<uint32_t>(e);
-      batch_ci_[c] = ci;
+      ts.entry[c] = static_cast<uint32_t>(e);
+      ts.ci[c] = ci;
       max_ratio = std::max(max_ratio, delta / (2.0 * s.radius[i]));
       if (++c == ContactPipeline::kBatchSize) flush();
     }

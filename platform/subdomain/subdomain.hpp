@@ -12,6 +12,7 @@
 #include "core/material.hpp"
 #include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
+#include "core/thread_pool.hpp"
 #include "geometry/wall.hpp"
 #include "geometry/wall_neighbors.hpp"
 
@@ -59,6 +60,11 @@ class Subdomain {
   void set_skin(double skin) { skin_ = skin; }
   double skin() const { return skin_; }
   void set_time_step(double dt) { dt_ = dt; }
+  /// Worker threads for the force and integration loops (>= 1). Results are
+  /// bit-identical run to run for a fixed count; different counts agree to
+  /// round-off (the pair forces are summed in a different order).
+  void set_threads(int threads);
+  int threads() const { return pool_->size(); }
   double time_step() const { return dt_; }
 
   /// Estimate contact time and stability limit from the contact model itself:
@@ -77,9 +83,26 @@ class Subdomain {
   SubdomainStats stats() const;
 
  private:
+  /// One thread's batch workspace, batch bookkeeping and force accumulators.
+  struct ThreadScratch {
+    std::unique_ptr<ContactPipeline::Workspace> ws;
+    std::vector<uint32_t> entry;     ///< list entry of each batch slot
+    std::vector<double> ci, cj;      ///< lever arms of each batch slot
+    std::vector<double> fx, fy, fz, tx, ty, tz;  ///< accumulators (threads > 0)
+    std::vector<uint32_t> contacts;
+    std::size_t n_contacts = 0;
+    double max_ratio = 0;
+  };
+  /// Where a thread adds forces: the store itself (thread 0) or its own arrays.
+  struct Accumulator {
+    double *fx, *fy, *fz, *tx, *ty, *tz;
+    uint32_t* contacts;
+  };
+
   void rebuild_lists();
   void compute_forces();
   void pair_forces();
+  void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc);
   void wall_forces();
 
   std::string name_;
@@ -100,9 +123,8 @@ class Subdomain {
   std::uint64_t steps_ = 0;
   std::size_t last_contacts_ = 0, last_wall_contacts_ = 0;
   double last_max_overlap_ratio_ = 0;
-  // scratch of one batch: which list entry and the lever arms
-  std::vector<uint32_t> batch_entry_;
-  std::vector<double> batch_ci_, batch_cj_;
+  std::vector<ThreadScratch> scratch_;
+  std::unique_ptr<ThreadPool> pool_;
 };
 
 }  // namespace domel::platform

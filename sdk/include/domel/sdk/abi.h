@@ -164,6 +164,9 @@ typedef struct domel_insert_output_v1 {
 typedef domel_status (*domel_create_fn)(const char* params_json, const domel_host_v1* host,
                                         void** out_instance, char* err, size_t err_capacity);
 typedef void (*domel_destroy_fn)(void* instance);
+/* Thread safety (ABI 1.1): the host may call `contact` of ONE instance from
+ * several threads at once, each with its own batch. A contact kernel must
+ * therefore not modify its instance; per-contact state belongs in history. */
 typedef domel_status (*domel_contact_fn)(void* instance, domel_contact_batch_v1* batch,
                                          char* err, size_t err_capacity);
 typedef domel_status (*domel_insert_fn)(void* instance, const domel_insert_request_v1* request,

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: MIT
+// The worker team: a generation counter announces each job; workers spin a
+// few microseconds on it (cheap on an idle machine) before sleeping on a
+// condition variable (cheap on a busy one).
+#include "core/thread_pool.hpp"
+
+#include <algorithm>
+
+namespace domel::platform {
+
+namespace {
+constexpr int kSpin = 4000;
+}
+
+ThreadPool::ThreadPool(int threads) : size_(std::max(1, threads)), errors_(static_cast<std::size_t>(size_)) {
+  for (int t = 1; t < size_; ++t) workers_.emplace_back([this, t] { worker(t); });
+}
+
+ThreadPool::~ThreadPool() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+    generation_.fetch_add(1);
+  }
+  wake_.notify_all();
+  for (auto& w : workers_) w.join();
+}
+
+void ThreadPool::run(const std::function<void(int)>& fn) {
+  if (size_ == 1) {
+    fn(0);
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    job_ = &fn;
+    std::fill(errors_.begin(), errors_.end(), nullptr);
+    pending_.store(size_ - 1);
+    generation_.fetch_add(1);
+  }
+  wake_.notify_all();
+  try {
+    fn(0);
+  } catch (...) {
+    errors_[0] = std::current_exception();
+  }
+  for (int k = 0; k < kSpin && pending_.load() > 0; ++k) std::this_thread::yield();
+  if (pending_.load() > 0) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return pending_.load() == 0; });
+  }
+  for (const auto& e : errors_)
+    if (e) std::rethrow_exception(e);
+}
+
+void ThreadPool::worker(int t) {
+  std::uint64_t seen = 0;
+  for (;;) {
+    for (int k = 0; k < kSpin && generation_.load() == seen; ++k) std::this_thread::yield();
+    const std::function<void(int)>* job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [&] { return generation_.load() != seen; });
+      seen = generation_.load();
+      if (stop_) return;
+      job = job_;
+    }
+    try {
+      (*job)(t);
+    } catch (...) {
+      errors_[static_cast<std::size_t>(t)] = std::current_exception();
+    }
+    if (pending_.fetch_sub(1) == 1) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_.notify_one();
+    }
+  }
+}
+
+}  // namespace domel::platform
