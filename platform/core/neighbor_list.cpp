@@ -104,6 +104,7 @@ void NeighborList::build(const ParticleStore& s) {
             for (uint32_t q = start[cc]; q < start[cc + 1]; ++q) {
               const uint32_t b = order[q];
               if (b <= a) continue;
+              if ((s.flags[a] & s.flags[b] & ParticleStore::kFixed) != 0) continue;  // two fixed: never interact
               const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
               const double cut = s.radius[a] + s.radius[b] + skin_;
               if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) {

@@ -7,7 +7,7 @@
 namespace domel::platform {
 
 void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, double r,
-                        double density) {
+                        double density, bool fixed) {
   const double m = density * 4.0 / 3.0 * M_PI * r * r * r;
   const double inertia = 0.4 * m * r * r;  // solid sphere
   id.push_back(pid);
@@ -15,9 +15,10 @@ void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, doub
   for (auto* v : {&vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz}) v->push_back(0.0);
   radius.push_back(r);
   mass.push_back(m);
-  inv_mass.push_back(1.0 / m);
-  inv_inertia.push_back(1.0 / inertia);
+  inv_mass.push_back(fixed ? 0.0 : 1.0 / m);
+  inv_inertia.push_back(fixed ? 0.0 : 1.0 / inertia);
   contacts.push_back(0);
+  flags.push_back(fixed ? kFixed : 0);
 }
 
 void ParticleStore::swap_remove(std::size_t k) {

@@ -22,11 +22,18 @@ struct ParticleStore {
   std::vector<double> inv_mass;            ///< 1/mass [1/kg]
   std::vector<double> inv_inertia;         ///< 1/I, I = 2/5 m r^2 for a solid sphere [1/(kg m^2)]
   std::vector<std::uint32_t> contacts;     ///< contact count in the last force evaluation
+  std::vector<std::uint8_t> flags;         ///< kFixed, ...
+
+  /// A fixed particle is never moved (inverse mass and inertia 0, so the
+  /// integrator leaves it at rest) but is a full contact partner with its real
+  /// mass in m*, as LIGGGHTS' non-integrated particles are (a rough floor).
+  static constexpr std::uint8_t kFixed = 1;
+  bool fixed(std::size_t k) const { return (flags[k] & kFixed) != 0; }
 
   std::size_t size() const { return id.size(); }
 
   /// Append one particle at rest. Mass from density and radius.
-  void add(std::uint64_t pid, double px, double py, double pz, double r, double density);
+  void add(std::uint64_t pid, double px, double py, double pz, double r, double density, bool fixed = false);
 
   /// Remove particle k by moving the last one into its place.
   void swap_remove(std::size_t k);
@@ -39,7 +46,7 @@ struct ParticleStore {
   void for_each_array(F&& f) {
     f(id); f(x); f(y); f(z); f(vx); f(vy); f(vz); f(wx); f(wy); f(wz);
     f(fx); f(fy); f(fz); f(tx); f(ty); f(tz);
-    f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts);
+    f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts); f(flags);
   }
 };
 

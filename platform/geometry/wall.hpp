@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <string>
 
 namespace domel::platform {
@@ -26,6 +27,8 @@ struct WallPrimitive {
   double c[3] = {0, 0, 0};
   double radius = 0.0;
   double lo = 0.0, hi = 0.0;
+  /// simulated time from which the wall is gone (an outlet plug, a lifted cylinder)
+  double remove_at = std::numeric_limits<double>::infinity();
 
   /// Distance `d` of the point from the surface (positive on the particle
   /// side) and unit normal (nx, ny, nz) from the wall to the point. Returns

@@ -3,11 +3,16 @@
 #include "geometry/wall_neighbors.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 
 namespace domel::platform {
 
 void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride) {
+  if (!std::isinf(w.remove_at) && w.remove_at <= 0.0) {  // removed from the start
+    *this = WallNeighbors{};
+    return;
+  }
   std::unordered_map<std::uint64_t, std::size_t> old;
   std::vector<double> old_history;
   old_history.swap(history);

@@ -71,7 +71,7 @@ int axis_index(const json* j) {
 
 /// Platform keys of a model block that are not the plugin's parameters.
 std::vector<std::string> platform_keys(uint32_t kind) {
-  if (kind == DOMEL_KIND_INSERTION) return {"model", "region", "seed", "velocity"};
+  if (kind == DOMEL_KIND_INSERTION) return {"model", "region", "seed", "velocity", "fixed"};
   return {"model"};
 }
 
@@ -219,9 +219,11 @@ void check_references(Checker& ck, const json& doc) {
   std::set<std::string> wall_names;
   if (const json* walls = member(doc, "walls"); walls && walls->is_array()) {
     static const std::map<std::string, std::set<std::string>> kAllowed = {
-        {"plane", {"name", "type", "material", "point", "normal"}},
-        {"box", {"name", "type", "material", "min", "max", "open"}},
-        {"cylinder", {"name", "type", "material", "axis", "center", "radius", "bottom", "top", "closed_bottom", "closed_top"}}};
+        {"plane", {"name", "type", "material", "point", "normal", "remove_at"}},
+        {"box", {"name", "type", "material", "min", "max", "open", "remove_at"}},
+        {"cylinder",
+         {"name", "type", "material", "axis", "center", "radius", "bottom", "top", "closed_bottom", "closed_top",
+          "remove_at"}}};
     static const std::map<std::string, std::vector<std::string>> kRequired = {
         {"plane", {"point", "normal"}}, {"box", {"min", "max"}}, {"cylinder", {"center", "radius", "bottom", "top"}}};
     for (std::size_t k = 0; k < walls->size(); ++k) {
@@ -385,7 +387,7 @@ domel_region_v1 make_region(const json& region) {
   return r;
 }
 
-std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material) {
+std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material) {
   std::vector<WallPrimitive> out;
   const std::string name = w["name"].get<std::string>();
   const std::string type = w["type"].get<std::string>();
@@ -437,6 +439,13 @@ std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material) {
       plane(name + ".top", p, n);
     }
   }
+  return out;
+}
+
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material) {
+  std::vector<WallPrimitive> out = expand_wall_shape(w, material);
+  if (w.contains("remove_at"))
+    for (auto& p : out) p.remove_at = w["remove_at"].get<double>();
   return out;
 }
 
@@ -549,8 +558,9 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
           if (block.contains("velocity"))
             for (int a = 0; a < 3; ++a) v[a] = block["velocity"][a].get<double>();
           const double density = sim->materials[mat_index.at(mat_name)].density;
+          const bool fixed = block.value("fixed", false);
           for (std::size_t p = 0; p < x.size(); ++p) {
-            st.add(next_id++, x[p], y[p], z[p], r[p], density);
+            st.add(next_id++, x[p], y[p], z[p], r[p], density, fixed);
             st.vx.back() = v[0]; st.vy.back() = v[1]; st.vz.back() = v[2];
           }
           spdlog::info("subdomain '{}': inserted {} particles with '{}' ({})", sd_name, x.size(), m->name, where);
@@ -627,6 +637,17 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   sim->output_directory = out.value("directory", sim->name + "_out");
   sim->vtk_interval = out.value("vtk_interval", sim->duration / 50.0);
   sim->probe_interval = out.value("probe_interval", sim->duration / 500.0);
+  if (out.contains("repose_angle")) {
+    const json& r = out["repose_angle"];
+    ReposeProbeSettings rp;
+    rp.base_height = r.value("base_height", 0.0);
+    rp.cell = r.value("cell", 1.5);
+    if (r.contains("band")) {
+      rp.band_lo = r["band"][0].get<double>();
+      rp.band_hi = r["band"][1].get<double>();
+    }
+    sim->repose_probe = rp;
+  }
   return sim;
 }
 

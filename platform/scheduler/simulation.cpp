@@ -70,8 +70,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   std::vector<std::string> columns = {"time"};
   for (const auto& sd : subdomains)
     for (const char* c : {"particles", "ke_translational", "ke_rotational", "mean_angular_speed",
-                          "max_overlap_ratio", "contacts", "wall_contacts"})
+                          "median_angular_speed", "trimmed_mean_angular_speed", "max_overlap_ratio", "contacts",
+                          "wall_contacts"})
       columns.push_back(sd->name() + "." + c);
+  if (repose_probe)
+    for (const auto& sd : subdomains) columns.push_back(sd->name() + ".repose_angle_deg");
   std::unique_ptr<io::CsvSeries> probes;
   if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
   std::unique_ptr<io::VtkSeriesWriter> vtk;
@@ -81,9 +84,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     for (const auto& sd : subdomains) {
       const SubdomainStats st = sd->stats();
       row.insert(row.end(), {static_cast<double>(st.particles), st.kinetic_translational, st.kinetic_rotational,
-                             st.mean_angular_speed, st.max_overlap_ratio, static_cast<double>(st.contacts),
+                             st.mean_angular_speed, st.median_angular_speed, st.trimmed_mean_angular_speed,
+                             st.max_overlap_ratio, static_cast<double>(st.contacts),
                              static_cast<double>(st.wall_contacts)});
     }
+    if (repose_probe)
+      for (const auto& sd : subdomains)
+        row.push_back(repose_angle(sd->store(), *repose_probe).value_or(std::nan("")));
     probes->append(row);
   };
   auto write_vtk = [&](double t) {
@@ -184,9 +191,19 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                    {"final", {{"ke_translational_J", st.kinetic_translational},
                               {"ke_rotational_J", st.kinetic_rotational},
                               {"mean_angular_speed", st.mean_angular_speed},
+                              {"median_angular_speed", st.median_angular_speed},
+                              {"trimmed_mean_angular_speed", st.trimmed_mean_angular_speed},
                               {"max_overlap_ratio", st.max_overlap_ratio},
                               {"contacts", st.contacts},
                               {"wall_contacts", st.wall_contacts}}}});
+  }
+  if (repose_probe) {
+    nlohmann::json angles = nlohmann::json::object();
+    for (const auto& sd : subdomains) {
+      const auto a = repose_angle(sd->store(), *repose_probe);
+      angles[sd->name()] = a ? nlohmann::json(*a) : nlohmann::json(nullptr);
+    }
+    summary["repose_angle_deg"] = angles;
   }
   summary["subdomains"] = sds;
   if (options.time_after && m > options.time_after) {

@@ -8,12 +8,14 @@
 #include "core/material.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
+#include "subdomain/repose_probe.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,7 @@ class Simulation {
   int threads = 1;
   double vtk_interval = 0;
   double probe_interval = 0;
+  std::optional<ReposeProbeSettings> repose_probe;  ///< adds <subdomain>.repose_angle_deg to probes.csv
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
 

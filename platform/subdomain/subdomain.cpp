@@ -152,7 +152,7 @@ void Subdomain::setup() {
 void Subdomain::rebuild_lists() {
   nlist_.build(store_);
   for (std::size_t w = 0; w < wall_lists_.size(); ++w)
-    wall_lists_[w].build(store_, (*walls_)[w], skin_, pipeline_->history_stride());
+    if (time_ < (*walls_)[w].remove_at) wall_lists_[w].build(store_, (*walls_)[w], skin_, pipeline_->history_stride());
 }
 
 void Subdomain::step() {
@@ -341,6 +341,10 @@ void Subdomain::wall_forces() {
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     WallNeighbors& list = wall_lists_[w];
     const WallPrimitive& wall = (*walls_)[w];
+    if (time_ >= wall.remove_at) {  // removed: its contacts open for good
+      if (!list.particle.empty()) list = WallNeighbors{};
+      continue;
+    }
     uint32_t c = 0;
     auto flush = [&]() {
       if (c == 0) return;
@@ -407,14 +411,35 @@ SubdomainStats Subdomain::stats() const {
   st.contacts = last_contacts_;
   st.wall_contacts = last_wall_contacts_;
   st.max_overlap_ratio = last_max_overlap_ratio_;
-  double sum_w = 0;
+  double sum_w = 0, sum_slow = 0;
+  std::size_t slow = 0;
+  std::vector<double> speeds;
+  speeds.reserve(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) {
+    if (s.fixed(k)) {
+      ++st.fixed;
+      continue;
+    }
     st.kinetic_translational += 0.5 * s.mass[k] * (s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k]);
     const double w2 = s.wx[k] * s.wx[k] + s.wy[k] * s.wy[k] + s.wz[k] * s.wz[k];
     st.kinetic_rotational += 0.5 * w2 / s.inv_inertia[k];
-    sum_w += std::sqrt(w2);
+    const double speed = std::sqrt(w2);
+    speeds.push_back(speed);
+    sum_w += speed;
+    if (speed < 1.0) {
+      sum_slow += speed;
+      ++slow;
+    }
   }
-  if (s.size()) st.mean_angular_speed = sum_w / s.size();
+  if (!speeds.empty()) {
+    st.mean_angular_speed = sum_w / speeds.size();
+    const std::size_t mid = speeds.size() / 2;
+    std::nth_element(speeds.begin(), speeds.begin() + mid, speeds.end());
+    double median = speeds[mid];
+    if (speeds.size() % 2 == 0) median = 0.5 * (median + *std::max_element(speeds.begin(), speeds.begin() + mid));
+    st.median_angular_speed = median;
+  }
+  if (slow) st.trimmed_mean_angular_speed = sum_slow / slow;
   return st;
 }
 

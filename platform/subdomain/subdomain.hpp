@@ -24,12 +24,19 @@ namespace domel::platform {
 
 /// Observables of the last force evaluation and the current state.
 struct SubdomainStats {
-  std::size_t particles = 0;
+  std::size_t particles = 0;         ///< all particles, fixed ones included
+  std::size_t fixed = 0;             ///< fixed particles (not in the kinetic statistics)
   std::size_t contacts = 0;          ///< particle-particle contacts
   std::size_t wall_contacts = 0;
   double kinetic_translational = 0;  ///< [J]
   double kinetic_rotational = 0;     ///< [J]
   double mean_angular_speed = 0;     ///< mean |omega| [rad/s]
+  /// median |omega| [rad/s]: robust against the few particles that spin
+  /// freely about their contact normal, which rolling models do not resist
+  /// and which pin the plain mean (peers/RESULTS.md §2)
+  double median_angular_speed = 0;
+  /// mean |omega| over particles with |omega| < 1 rad/s [rad/s] (the peers' trimmed statistic)
+  double trimmed_mean_angular_speed = 0;
   double max_overlap_ratio = 0;      ///< max delta / (mean diameter of the pair), walls: delta / d
 };
 

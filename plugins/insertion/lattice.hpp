@@ -36,7 +36,7 @@ class Lattice {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_INSERTION;
   static constexpr const char* kName = "lattice";
-  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kVersion = "1.1.0";
   static constexpr const char* kSummary =
       "equal spheres on a simple cubic lattice filling the region, optionally jittered";
   static constexpr const char* kSchema = R"json({
@@ -53,7 +53,9 @@ class Lattice {
     "count": { "type": "integer", "minimum": 1,
                "description": "stop after this many particles (default: fill every site)" },
     "arrangement": { "enum": ["simple_cubic"], "default": "simple_cubic",
-                     "description": "lattice type" }
+                     "description": "lattice type" },
+    "origin": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m",
+                "description": "anchor the lattice: sites at origin + (i + 0.5) a for integer i (default: the region's lower corner), e.g. to reproduce another code's lattice" }
   },
   "required": ["diameter"],
   "additionalProperties": false
@@ -82,6 +84,12 @@ class Lattice {
         throw sdk::ParameterError("lattice: 'count' must be an integer >= 1");
       count_ = static_cast<std::size_t>(c);
     }
+    if (p.has("origin")) {
+      const auto& o = p.json().at("origin");
+      if (!o.is_array() || o.size() != 3) throw sdk::ParameterError("lattice: 'origin' must be [x, y, z]");
+      for (int k = 0; k < 3; ++k) origin_[k] = o[k].get<double>();
+      has_origin_ = true;
+    }
     const std::string arrangement = p.string_or("arrangement", "simple_cubic");
     if (arrangement != "simple_cubic")
       throw sdk::ParameterError("lattice: unknown 'arrangement' '" + arrangement +
@@ -98,10 +106,21 @@ class Lattice {
     const double jitter = jitter_ * d;
     const Bounds b = region_bounds(g);
 
-    long long n[3];
+    // sites at base + (i + 0.5) a for i = first[k] .. first[k] + n[k] - 1
+    long long n[3], first[3] = {0, 0, 0};
+    double base[3] = {b.lo[0], b.lo[1], b.lo[2]};
     double sites = 1.0;
     for (int k = 0; k < 3; ++k) {
-      const double f = std::floor((b.hi[k] - b.lo[k]) / a + 1e-9);
+      double f;
+      if (has_origin_) {
+        base[k] = origin_[k];
+        const double i0 = std::ceil((b.lo[k] - base[k]) / a - 0.5 - 1e-9);
+        const double i1 = std::floor((b.hi[k] - base[k]) / a - 0.5 + 1e-9);
+        f = i1 - i0 + 1.0;
+        first[k] = static_cast<long long>(i0);
+      } else {
+        f = std::floor((b.hi[k] - b.lo[k]) / a + 1e-9);
+      }
       sites *= std::max(f, 0.0);
       n[k] = f > 0.0 ? static_cast<long long>(std::min(f, 1e15)) : 0;
     }
@@ -125,9 +144,9 @@ class Lattice {
     for (long long iz = 0; iz < n[2]; ++iz)
       for (long long iy = 0; iy < n[1]; ++iy)
         for (long long ix = 0; ix < n[0]; ++ix) {
-          const double sx = b.lo[0] + (static_cast<double>(ix) + 0.5) * a;
-          const double sy = b.lo[1] + (static_cast<double>(iy) + 0.5) * a;
-          const double sz = b.lo[2] + (static_cast<double>(iz) + 0.5) * a;
+          const double sx = base[0] + (static_cast<double>(first[0] + ix) + 0.5) * a;
+          const double sy = base[1] + (static_cast<double>(first[1] + iy) + 0.5) * a;
+          const double sz = base[2] + (static_cast<double>(first[2] + iz) + 0.5) * a;
           if (!sphere_inside(g, sx, sy, sz, r)) continue;
           any_site = true;
           double x = sx, y = sy, z = sz;
@@ -155,6 +174,8 @@ class Lattice {
   double diameter_;
   double spacing_;
   double jitter_;
+  double origin_[3] = {0, 0, 0};
+  bool has_origin_ = false;
   std::size_t count_ = 0;  // 0: no limit
 };
 

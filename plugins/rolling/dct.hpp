@@ -22,7 +22,7 @@ class Dct {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_ROLLING;
   static constexpr const char* kName = "dct";
-  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kVersion = "1.0.1";
   static constexpr const char* kSummary =
       "directional constant rolling torque mu_r R* |F_n| opposing the relative rolling (Ai et al. 2011 model A)";
   static constexpr const char* kSchema = R"json({
@@ -48,7 +48,10 @@ class Dct {
     for (uint32_t c = 0; c < b.n; ++c) {
       const Vec3 w = rolling_velocity(b, c);
       const double len = std::sqrt(w.x * w.x + w.y * w.y + w.z * w.z);
-      if (len <= 0.0) continue;
+      // No rolling: also when only round-off of removing a pure twist is left
+      // (its direction would be random and the torque is full-size).
+      const double full = std::sqrt(b.wx[c] * b.wx[c] + b.wy[c] * b.wy[c] + b.wz[c] * b.wz[c]);
+      if (len <= 1e-12 * full || len == 0.0) continue;
       const double m = mu_r_ * b.r_eff[c] * cap_force(b, c) / len;
       b.tqx[c] -= m * w.x; b.tqy[c] -= m * w.y; b.tqz[c] -= m * w.z;
     }

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Surface-cell cone fit of a heap (see repose_probe.hpp).
+#include "subdomain/repose_probe.hpp"
+
+#include <cmath>
+#include <map>
+#include <utility>
+
+namespace domel::platform {
+
+std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSettings& settings) {
+  double xc = 0, yc = 0, dsum = 0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (s.fixed(k)) continue;
+    xc += s.x[k]; yc += s.y[k]; dsum += 2.0 * s.radius[k];
+    ++n;
+  }
+  if (n < 10) return std::nullopt;
+  xc /= n; yc /= n;
+  const double cs = settings.cell * dsum / n;
+  std::map<std::pair<long, long>, double> top;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (s.fixed(k)) continue;
+    const std::pair<long, long> key{static_cast<long>(std::floor((s.x[k] - xc) / cs)),
+                                    static_cast<long>(std::floor((s.y[k] - yc) / cs))};
+    const double h = s.z[k] + s.radius[k] - settings.base_height;
+    auto it = top.find(key);
+    if (it == top.end() || h > it->second) top[key] = h;
+  }
+  double hmax = -1e300;
+  for (const auto& [key, h] : top) hmax = std::max(hmax, h);
+  double sr = 0, sh = 0, srr = 0, srh = 0;
+  std::size_t m = 0;
+  for (const auto& [key, h] : top) {
+    if (!(h > settings.band_lo * hmax && h < settings.band_hi * hmax)) continue;
+    const double r = std::hypot((key.first + 0.5) * cs, (key.second + 0.5) * cs);
+    sr += r; sh += h; srr += r * r; srh += r * h;
+    ++m;
+  }
+  if (m < 3) return std::nullopt;
+  const double den = m * srr - sr * sr;
+  if (den <= 0) return std::nullopt;
+  const double slope = (m * srh - sr * sh) / den;
+  if (slope >= 0) return std::nullopt;
+  return std::atan(-slope) * 180.0 / M_PI;
+}
+
+}  // namespace domel::platform

@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: MIT
+// Angle-of-repose probe: the slope of a heap's free surface, measured the
+// way the peers' analysis does (shared/peers/analysis/repose_analysis.py,
+// "pooled" fit) so that numbers compare directly:
+//  - mobile particles only; height h = z + r - base_height;
+//  - horizontal centre = centroid (x, y) of the particles;
+//  - square xy cells of side cell * d (d = mean diameter), surface height of
+//    a cell = highest particle top in it, at the cell centre's radius r;
+//  - least-squares line h(r) through the cells with band_lo < h/H_max < band_hi
+//    (drops the rounded apex and the one-particle-thick toe);
+//  - angle = atan(-slope), in degrees.
+#pragma once
+
+#include "core/particle_store.hpp"
+
+#include <optional>
+
+namespace domel::platform {
+
+struct ReposeProbeSettings {
+  double base_height = 0.0;  ///< [m] height of the floor the heap rests on
+  double cell = 1.5;         ///< cell side in mean particle diameters
+  double band_lo = 0.2, band_hi = 0.8;
+};
+
+/// The angle in degrees, or nothing when the surface gives no descending fit.
+std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSettings& settings);
+
+}  // namespace domel::platform
