@@ -4,6 +4,7 @@
 // options per sub-command does not justify another dependency.
 // Exit codes: 0 success, 1 the run failed, 2 the scenario (or a plugin) was
 // refused, 64 wrong command-line usage.
+#include "apps/compare.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "loader/plugin_registry.hpp"
@@ -34,6 +35,11 @@ commands:
                       (ParaView), probes.csv and summary.json into the output folder.
                       --max-steps stops early; --time-after N also reports the speed of
                       the steps after the first N (benchmarks, in summary.json)
+  compare FILE --vary POINTER=VALUE[;POINTER=VALUE...] [--vary ...] [--label NAME ...]
+          [--out DIR] [--threads N] [--max-steps N]
+                      run variants of one scenario (same seeds and insertion) and write
+                      DIR/report.md with a table of final values and PNG plots, e.g.
+                      --vary '/subdomains/0/contact/rolling={"model":"dct","rolling_friction":0.1}'
   validate FILE...    check scenarios without running them; lists every problem
   plugins [--json]    list loaded plugin models with versions, ABI and parameters
   schema [--out FILE] print the complete scenario JSON Schema (for editors, via "$schema")
@@ -146,6 +152,48 @@ int cmd_run(int argc, char** argv) {
   return 0;
 }
 
+int cmd_compare(int argc, char** argv) {
+  // --vary and --label repeat, so they are collected here rather than by parse()
+  dp::CompareOptions opt;
+  std::vector<std::string> varies, labels;
+  std::vector<std::string> rest_args;
+  for (int k = 2; k < argc; ++k) {
+    const std::string s = argv[k];
+    if ((s == "--vary" || s == "--label") && k + 1 < argc) {
+      (s == "--vary" ? varies : labels).push_back(argv[++k]);
+    } else if (s == "--vary" || s == "--label") {
+      throw UsageError("option " + s + " needs a value");
+    } else {
+      rest_args.push_back(s);
+    }
+  }
+  std::vector<char*> rest = {argv[0], argv[1]};
+  for (auto& s : rest_args) rest.push_back(s.data());
+  const Args a = parse(static_cast<int>(rest.size()), rest.data(), 2, {"--out", "--threads", "--max-steps"}, {"--quiet"});
+  if (a.positional.size() != 1) throw UsageError("compare expects one scenario file");
+  if (varies.size() < 2) throw UsageError("compare needs at least two --vary variants");
+  if (!labels.empty() && labels.size() != varies.size())
+    throw UsageError("give one --label per --vary (or none)");
+  if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
+  opt.scenario = a.positional[0];
+  opt.output_directory = a.option("--out").value_or(std::filesystem::path(opt.scenario).stem().string() + "_compare");
+  if (auto t = a.option("--threads")) opt.threads = static_cast<int>(parse_count("--threads", *t));
+  if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
+  dp::PluginRegistry registry;
+  load_default_plugins(registry);
+  try {
+    for (std::size_t k = 0; k < varies.size(); ++k)
+      opt.variants.push_back(dp::parse_variant(varies[k], labels.empty() ? "" : labels[k]));
+    const auto report = dp::run_compare(opt, registry);
+    std::printf("report: %s\n", report.string().c_str());
+  } catch (const dp::ConfigError& e) {
+    print_diagnostics(opt.scenario.string(), e.diagnostics());
+    std::fprintf(stderr, "nothing was run.\n");
+    return kExitRefused;
+  }
+  return 0;
+}
+
 int cmd_validate(int argc, char** argv) {
   const Args a = parse(argc, argv, 2, {}, {});
   if (a.positional.empty()) throw UsageError("validate expects at least one scenario file");
@@ -240,6 +288,7 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "run") return cmd_run(argc, argv);
     if (cmd == "validate") return cmd_validate(argc, argv);
+    if (cmd == "compare") return cmd_compare(argc, argv);
     if (cmd == "plugins") return cmd_plugins(argc, argv);
     if (cmd == "schema") return cmd_schema(argc, argv);
     if (cmd == "docs") return cmd_docs(argc, argv);
@@ -251,7 +300,7 @@ int main(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       return 0;
     }
-    const std::string hint = dp::suggest(cmd, {"run", "validate", "plugins", "schema", "docs", "version", "help"});
+    const std::string hint = dp::suggest(cmd, {"run", "compare", "validate", "plugins", "schema", "docs", "version", "help"});
     throw UsageError("unknown command '" + cmd + "'" + (hint.empty() ? "" : " (" + hint + ")"));
   } catch (const UsageError& e) {
     std::fprintf(stderr, "domel: %s\n\n%s", e.what(), kUsage);

@@ -69,8 +69,9 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
   // spheres: I/2; sphere on a wall: I), for the rolling spring's own limit
   // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
   // (docs/physics.md §3.6).
-  auto collide = [&](const domel_pair_v1& pair, double r_eff, double m_eff, double i_red, double& t_contact,
-                     double& dt_crit, bool& rolling_sets_limit) {
+  auto collide = [&](const domel_pair_v1& pair, double r_i, double r_j, double m_eff, double i_red,
+                     double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
+    const double r_eff = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
     // contact opens, with a step refined until the duration converges.
     double h = 1e-3 * r_eff / impact_velocity;
@@ -80,7 +81,7 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
       bool rolling = false;
       auto force = [&](double d, double vel) {
         buf.overlap[0] = std::max(d, 1e-300);
-        buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_eff; buf.radius_j[0] = 0;
+        buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_i; buf.radius_j[0] = r_j;
         buf.nx[0] = 0; buf.ny[0] = 0; buf.nz[0] = 1; buf.vn[0] = vel;
         buf.vtx[0] = buf.vty[0] = buf.vtz[0] = 0; buf.wx[0] = buf.wy[0] = buf.wz[0] = 0;
         std::fill(buf.history.begin(), buf.history.end(), 0.0);
@@ -126,12 +127,12 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
   const double inertia = 0.4 * m * r * r;  // solid sphere
   double tc, crit;
   bool rolling = false;
-  collide(self_pair_, 0.5 * r, 0.5 * m, 0.5 * inertia, tc, crit, rolling);
+  collide(self_pair_, r, r, 0.5 * m, 0.5 * inertia, tc, crit, rolling);
   rep.contact_time = tc;
   rep.critical = crit;
   rep.critical_of = rolling ? "rolling spring of the particle-particle contact" : "particle-particle contact";
   for (std::size_t w = 0; w < wall_pairs_.size(); ++w) {
-    collide(wall_pairs_[w], r, m, inertia, tc, crit, rolling);
+    collide(wall_pairs_[w], r, 0.0, m, inertia, tc, crit, rolling);
     rep.contact_time = std::min(rep.contact_time, tc);
     if (crit < rep.critical) {
       rep.critical = crit;

@@ -18,9 +18,11 @@ inline Vec3 rolling_velocity(const domel_contact_batch_v1& b, uint32_t c) {
 }
 
 /// The normal force that sets the torque cap: the elastic part, never
-/// negative (LIGGGHTS cdt/epsd use F_n,el too, docs/physics.md §2.1). The
-/// dashpot part changes sign with the normal velocity and would make the
-/// cap, and so the torque, jump during loading and unloading.
+/// negative. LIGGGHTS' cdt does the same (k_n delta_n, docs/physics.md §2.1);
+/// its epsd caps with the total |F_n| (elastic + dashpot). We use the elastic
+/// part for both built-ins: the dashpot part changes sign with the normal
+/// velocity and would make the cap, and so the torque, jump during loading
+/// and unloading; at rest the two agree.
 inline double cap_force(const domel_contact_batch_v1& b, uint32_t c) {
   return b.fn_elastic[c] > 0.0 ? b.fn_elastic[c] : 0.0;
 }

@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""Plots for `domel compare` (written next to the report and run by domel):
+one PNG per observable, one line per variant, from each variant's
+probes.csv. Usage: plot_compare.py OUTDIR LABEL=DIR [LABEL=DIR ...]"""
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+PLOTS = [  # (column suffix, title, y label, log scale)
+    ("median_angular_speed", "Median |omega| of the particles", "median |omega| [rad/s]", True),
+    ("trimmed_mean_angular_speed", "Mean |omega| of particles below 1 rad/s", "mean |omega| [rad/s]", True),
+    ("ke_translational", "Translational kinetic energy", "E_kin [J]", True),
+    ("ke_rotational", "Rotational kinetic energy", "E_rot [J]", True),
+    ("repose_angle_deg", "Angle of repose (free-surface fit)", "angle [deg]", False),
+]
+
+
+def read(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return rows
+
+
+def main():
+    out = sys.argv[1]
+    variants = [a.split("=", 1) for a in sys.argv[2:]]
+    data = {label: read(os.path.join(d, "probes.csv")) for label, d in variants}
+    written = []
+    for suffix, title, ylabel, log in PLOTS:
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        drawn = False
+        for label, rows in data.items():
+            cols = [c for c in (rows[0].keys() if rows else []) if c.endswith("." + suffix)]
+            for col in cols:
+                t, y = [], []
+                for r in rows:
+                    v = float(r[col])
+                    if math.isfinite(v) and (v > 0 or not log):
+                        t.append(float(r["time"]))
+                        y.append(v)
+                if t:
+                    name = label if len(cols) == 1 else f"{label} ({col.split('.')[0]})"
+                    ax.plot(t, y, label=name, linewidth=1.4)
+                    drawn = True
+        if not drawn:
+            plt.close(fig)
+            continue
+        if log:
+            ax.set_yscale("log")
+        ax.set_xlabel("simulated time [s]")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        fig.tight_layout()
+        name = f"{suffix}.png"
+        fig.savefig(os.path.join(out, name), dpi=110)
+        plt.close(fig)
+        written.append(name)
+    print("\n".join(written))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# Third-party rolling plugin check, run by ctest (third_party_rolling_epsd):
+#   third_party_rolling_check.sh <domel build dir> <examples/third_party_rolling>
+# Builds the EPSD example exactly as a third party would and runs it:
+# 1. installs the built domel project into a temporary prefix;
+# 2. configures and builds the example project against that prefix only
+#    (find_package(domel_sdk 1.1) + domel_add_plugin) into $tmp/build;
+# 3. copies scenario.json next to the built libdomel_rolling_epsd.so (the
+#    scenario names it by a path relative to itself), runs it with the
+#    installed domel, and checks summary.json: rolling model "epsd" from the
+#    library "third_party_rolling", and a settled pile (final kinetic energy
+#    below 1 % of the run's peak in probes.csv);
+# 4. `domel validate` on a copy with a misspelt epsd parameter: exit code 2
+#    and a did-you-mean naming the right key;
+# 5. removes the temporary folder, whatever happened.
+# The example's source folder is only read: nothing is written into it.
+set -euo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 <domel build dir> <third-party example dir>" >&2
+  exit 64
+fi
+build=$(cd "$1" && pwd)
+project=$(cd "$2" && pwd)
+module_name=libdomel_rolling_epsd.so
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/domel_third_party.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+prefix=$tmp/prefix
+
+fail() {
+  echo "third_party_rolling_check: FAIL: $*" >&2
+  exit 1
+}
+
+echo "== 1. install $build into $prefix"
+cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1 || {
+  cat "$tmp/install.log" >&2
+  fail "cmake --install failed"
+}
+[[ -f "$prefix/lib/cmake/domel_sdk/domel_sdkConfig.cmake" ]] || fail "not installed: lib/cmake/domel_sdk/domel_sdkConfig.cmake"
+[[ -x "$prefix/bin/domel" ]] || fail "not installed: bin/domel"
+domel=$prefix/bin/domel
+
+echo "== 2. build $project against the installed SDK"
+generator=()
+if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+cmake -S "$project" -B "$tmp/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/configure.log" 2>&1 || {
+  cat "$tmp/configure.log" >&2
+  fail "configuring the example failed"
+}
+grep -q "domel_sdk_DIR:PATH=$prefix/lib/cmake/domel_sdk" "$tmp/build/CMakeCache.txt" ||
+  fail "find_package(domel_sdk) did not pick the installed package: $(grep domel_sdk_DIR "$tmp/build/CMakeCache.txt")"
+nice cmake --build "$tmp/build" -j1 >"$tmp/build.log" 2>&1 || {
+  cat "$tmp/build.log" >&2
+  fail "building the example failed"
+}
+[[ -f "$tmp/build/$module_name" ]] || fail "no $module_name in $tmp/build"
+echo "built $tmp/build/$module_name"
+
+echo "== 3. run scenario.json with the plugin loaded by path"
+cp "$project/scenario.json" "$tmp/build/scenario.json"
+"$domel" run "$tmp/build/scenario.json" --out "$tmp/out" --quiet >"$tmp/run.log" 2>&1 || {
+  rc=$?
+  cat "$tmp/run.log" >&2
+  fail "domel run exited with $rc"
+}
+cat "$tmp/run.log"
+if grep "refused" "$tmp/run.log" | grep -q "$module_name"; then
+  fail "domel refused $module_name"
+fi
+[[ -f "$tmp/out/summary.json" ]] || fail "no summary.json in $tmp/out"
+python3 - "$tmp/out" "$tmp/build/$module_name" <<'EOF' || fail "summary.json check failed"
+import csv, json, os, sys
+out, module = sys.argv[1], sys.argv[2]
+s = json.load(open(os.path.join(out, "summary.json")))
+errors = []
+rolling = [(name, slots.get("rolling")) for name, slots in s["models"].items()]
+for name, r in rolling:
+    if not r or r.get("model") != "epsd" or r.get("library") != "third_party_rolling":
+        errors.append(f"subdomain '{name}': rolling slot is {r}, expected model 'epsd' from 'third_party_rolling'")
+    else:
+        print(f"summary.json: subdomain '{name}' rolling = {json.dumps(r, sort_keys=True)}")
+libs = [l for l in s["plugin_libraries"] if l["name"] == "third_party_rolling"]
+if len(libs) != 1 or os.path.realpath(libs[0]["path"]) != os.path.realpath(module):
+    errors.append(f"plugin_libraries does not list third_party_rolling at {module}: {s['plugin_libraries']}")
+else:
+    print(f"summary.json: library {json.dumps(libs[0], sort_keys=True)}")
+# The pile settles: the final kinetic energy (translational + rotational) is
+# below 1 % of the peak of the run (probes.csv). Typical: 1e-4 of the peak.
+rows = list(csv.DictReader(open(os.path.join(out, "probes.csv"))))
+for sd in s["subdomains"]:
+    name, fin = sd["name"], sd["final"]
+    ke = fin["ke_translational_J"] + fin["ke_rotational_J"]
+    peak = max(float(r[f"{name}.ke_translational"]) + float(r[f"{name}.ke_rotational"]) for r in rows)
+    print(f"subdomain '{name}': {sd['particles']} particles, {sd['steps']} steps; final KE {ke:.3g} J "
+          f"(translational {fin['ke_translational_J']:.3g}, rotational {fin['ke_rotational_J']:.3g}), "
+          f"peak KE {peak:.3g} J, ratio {ke / peak if peak > 0 else float('nan'):.2g}; "
+          f"mean |omega| {fin['mean_angular_speed']:.3g} rad/s; {fin['contacts']} contacts")
+    if not (peak > 0 and ke < 0.01 * peak):
+        errors.append(f"subdomain '{name}' has not settled: final KE {ke:.3g} J vs peak {peak:.3g} J")
+for e in errors:
+    print("error: " + e, file=sys.stderr)
+sys.exit(1 if errors else 0)
+EOF
+
+echo "== 4. domel validate reports a misspelt epsd parameter"
+sed 's/"rolling_friction"/"rolling_fricton"/' "$tmp/build/scenario.json" >"$tmp/build/scenario_typo.json"
+grep -q '"rolling_fricton"' "$tmp/build/scenario_typo.json" || fail "could not make the typo copy"
+rc=0
+"$domel" validate "$tmp/build/scenario_typo.json" >"$tmp/validate.log" 2>&1 || rc=$?
+cat "$tmp/validate.log"
+[[ $rc -eq 2 ]] || fail "domel validate exited with $rc on the typo, expected 2"
+grep -Fq "unknown property 'rolling_fricton' (did you mean 'rolling_friction'?)" "$tmp/validate.log" ||
+  fail "no did-you-mean for 'rolling_fricton'"
+grep -Fq "missing required property 'rolling_friction'" "$tmp/validate.log" ||
+  fail "the missing required 'rolling_friction' is not reported"
+
+echo "== 5. clean up $tmp"
+echo "third_party_rolling_check: OK"
