@@ -31,7 +31,10 @@ json read_json(const std::filesystem::path& p) {
 std::string fmt(double v) {
   if (!std::isfinite(v)) return "–";
   char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
+  if (v == std::floor(v) && std::fabs(v) < 1e15)
+    std::snprintf(b, sizeof b, "%.0f", v);  // counts: particles, contacts
+  else
+    std::snprintf(b, sizeof b, "%.3g", v);
   return b;
 }
 
@@ -51,6 +54,13 @@ std::vector<std::pair<std::string, double>> last_row(const std::filesystem::path
     out.emplace_back(h, end != v.c_str() ? x : std::nan(""));
   }
   return out;
+}
+
+/// Single-quotes an argument for /bin/sh.
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
 }
 
 std::string slug(const std::string& s) {
@@ -136,6 +146,7 @@ std::filesystem::path run_compare(const CompareOptions& options, PluginRegistry&
     ro.output_directory = out / slug(options.variants[k].label);
     ro.threads = options.threads;
     ro.max_steps = options.max_steps;
+    ro.progress = options.progress;
     spdlog::info("compare: variant {} of {}: {}", k + 1, sims.size(), options.variants[k].label);
     const RunResult r = sims[k]->run(ro, registry);
     dirs.push_back(ro.output_directory);
@@ -150,9 +161,9 @@ std::filesystem::path run_compare(const CompareOptions& options, PluginRegistry&
     // Debian's interpreter first: python3-matplotlib installs into it, while a
     // python3 earlier on PATH (pyenv, venv) may lack matplotlib.
     const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    std::string cmd = python + " '" + script.string() + "' '" + out.string() + "'";
+    std::string cmd = python + " " + shell_quote(script.string()) + " " + shell_quote(out.string());
     for (std::size_t k = 0; k < dirs.size(); ++k)
-      cmd += " '" + options.variants[k].label + "=" + dirs[k].string() + "'";
+      cmd += " " + shell_quote(options.variants[k].label) + " " + shell_quote(dirs[k].string());
     cmd += " 2>&1";
     if (FILE* p = popen(cmd.c_str(), "r")) {
       char line[512];

@@ -24,6 +24,7 @@ struct CompareOptions {
   std::vector<CompareVariant> variants;
   int threads = 0;
   std::uint64_t max_steps = 0;
+  bool progress = true;
 };
 
 /// Parses "POINTER=VALUE;POINTER=VALUE" (VALUE: JSON, or a bare string).

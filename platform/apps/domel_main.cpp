@@ -18,6 +18,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <thread>
 
 namespace dp = domel::platform;
 
@@ -100,6 +101,15 @@ long parse_count(const std::string& option, const std::string& value) {
   }
 }
 
+int parse_threads(const std::string& value) {
+  const long n = parse_count("--threads", value);
+  if (n > 256) throw UsageError("--threads expects at most 256, found " + value);
+  const unsigned cores = std::thread::hardware_concurrency();
+  if (cores > 0 && n > static_cast<long>(cores))
+    spdlog::warn("--threads {} exceeds the {} hardware threads of this machine; expect a slowdown", n, cores);
+  return static_cast<int>(n);
+}
+
 void load_default_plugins(dp::PluginRegistry& registry) {
   for (const auto& dir : dp::default_plugin_directories()) {
     const std::size_t n = registry.load_directory(dir);
@@ -124,7 +134,7 @@ int cmd_run(int argc, char** argv) {
   if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
   dp::RunOptions opt;
   if (auto o = a.option("--out")) opt.output_directory = *o;
-  if (auto t = a.option("--threads")) opt.threads = static_cast<int>(parse_count("--threads", *t));
+  if (auto t = a.option("--threads")) opt.threads = parse_threads(*t);
   if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
   if (auto s = a.option("--time-after")) opt.time_after = static_cast<std::uint64_t>(parse_count("--time-after", *s));
   opt.progress = !a.flag("--quiet");
@@ -175,9 +185,10 @@ int cmd_compare(int argc, char** argv) {
   if (!labels.empty() && labels.size() != varies.size())
     throw UsageError("give one --label per --vary (or none)");
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
+  opt.progress = !a.flag("--quiet");
   opt.scenario = a.positional[0];
   opt.output_directory = a.option("--out").value_or(std::filesystem::path(opt.scenario).stem().string() + "_compare");
-  if (auto t = a.option("--threads")) opt.threads = static_cast<int>(parse_count("--threads", *t));
+  if (auto t = a.option("--threads")) opt.threads = parse_threads(*t);
   if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
   dp::PluginRegistry registry;
   load_default_plugins(registry);

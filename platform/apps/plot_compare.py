@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots for `domel compare` (written next to the report and run by domel):
 one PNG per observable, one line per variant, from each variant's
-probes.csv. Usage: plot_compare.py OUTDIR LABEL=DIR [LABEL=DIR ...]"""
+probes.csv. Usage: plot_compare.py OUTDIR LABEL DIR [LABEL DIR ...]"""
 import csv
 import math
 import os
@@ -29,7 +29,8 @@ def read(path):
 
 def main():
     out = sys.argv[1]
-    variants = [a.split("=", 1) for a in sys.argv[2:]]
+    args = sys.argv[2:]
+    variants = list(zip(args[0::2], args[1::2]))
     data = {label: read(os.path.join(d, "probes.csv")) for label, d in variants}
     written = []
     for suffix, title, ylabel, log in PLOTS:

@@ -149,7 +149,7 @@ void PluginRegistry::load(const std::filesystem::path& path) {
     if (m.desc.kind == DOMEL_KIND_INSERTION) require(reinterpret_cast<const void*>(m.desc.insert), "insert");
     if (m.desc.kind == DOMEL_KIND_FLUID || m.desc.kind == DOMEL_KIND_CONTROLLER)
       refuse(file, who + ": " + what + ": this domel does not run " + kind_name(m.desc.kind) +
-                       " models yet (ABI 1.0 has no callbacks for them)");
+                       " models yet (this ABI has no callbacks for them)");
     m.version = m.desc.version;
     m.summary = m.desc.summary ? m.desc.summary : "";
     try {

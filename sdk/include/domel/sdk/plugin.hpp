@@ -133,7 +133,9 @@ struct Export {
                               std::size_t cap) {
     if constexpr (is_contact_kind(M::kKind)) {
       try {
-        static_cast<Instance<M>*>(self)->model.compute(*batch);
+        // through a const reference: kernels may run concurrently on one
+        // instance (abi.h), so compute() must not modify the model
+        static_cast<const M&>(static_cast<Instance<M>*>(self)->model).compute(*batch);
         return DOMEL_OK;
       } catch (const std::exception& e) {
         write_message(err, cap, e.what());
