@@ -17,16 +17,13 @@ inline std::uint64_t pair_key(std::uint64_t a, std::uint64_t b) {
 }  // namespace
 
 bool NeighborList::needs_rebuild(const ParticleStore& s) const {
-  if (builds_ == 0 || s.size() != built_size_) return true;
-  const double limit2 = 0.25 * skin_ * skin_;
+  if (layout_stale(s)) return true;
+  const double limit2 = rebuild_displacement2();
   const std::size_t n = s.size();
   for (std::size_t k = 0; k < n; ++k) {
     const double dx = s.x[k] - x0_[k], dy = s.y[k] - y0_[k], dz = s.z[k] - z0_[k];
     if (dx * dx + dy * dy + dz * dz > limit2) return true;
   }
-  // the same slots must hold the same particles (re-ordering forces a rebuild)
-  for (std::size_t k = 0; k < n; ++k)
-    if (s.id[k] != built_ids_[k]) return true;
   return false;
 }
 
@@ -130,6 +127,7 @@ void NeighborList::build(const ParticleStore& s) {
   x0_ = s.x; y0_ = s.y; z0_ = s.z;
   built_ids_ = s.id;
   built_size_ = n;
+  built_version_ = s.layout_version;
   ++builds_;
 }
 

@@ -25,7 +25,19 @@ class NeighborList {
   double skin() const { return skin_; }
   uint32_t stride() const { return stride_; }
 
+  /// Full check: the store's layout changed, or a particle moved more than
+  /// half the skin since the last build.
   bool needs_rebuild(const ParticleStore& s) const;
+  /// The layout part of needs_rebuild() alone (O(1)); callers that check the
+  /// displacement themselves (fused into the drift loop) use this.
+  bool layout_stale(const ParticleStore& s) const {
+    return builds_ == 0 || s.size() != built_size_ || s.layout_version != built_version_;
+  }
+  /// Positions at the last build, and the squared displacement that forces a rebuild.
+  const double* x0() const { return x0_.data(); }
+  const double* y0() const { return y0_.data(); }
+  const double* z0() const { return z0_.data(); }
+  double rebuild_displacement2() const { return 0.25 * skin_ * skin_; }
   void build(const ParticleStore& s);
   std::size_t size() const { return i.size(); }
   std::size_t builds() const { return builds_; }
@@ -39,8 +51,9 @@ class NeighborList {
   uint32_t stride_ = 0;
   std::size_t builds_ = 0;
   std::vector<double> x0_, y0_, z0_;
-  std::vector<std::uint64_t> built_ids_;
+  std::vector<std::uint64_t> built_ids_;  ///< ids at the last build (history carry-over)
   std::size_t built_size_ = 0;
+  std::uint64_t built_version_ = 0;
 };
 
 }  // namespace domel::platform

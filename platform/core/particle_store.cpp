@@ -19,6 +19,7 @@ void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, doub
   inv_inertia.push_back(fixed ? 0.0 : 1.0 / inertia);
   contacts.push_back(0);
   flags.push_back(fixed ? kFixed : 0);
+  ++layout_version;
 }
 
 void ParticleStore::swap_remove(std::size_t k) {
@@ -26,6 +27,7 @@ void ParticleStore::swap_remove(std::size_t k) {
     v[k] = v.back();
     v.pop_back();
   });
+  ++layout_version;
 }
 
 void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
@@ -33,6 +35,7 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
     auto tmp = v;
     for (std::size_t k = 0; k < order.size(); ++k) v[k] = tmp[order[k]];
   });
+  ++layout_version;
 }
 
 }  // namespace domel::platform

@@ -32,6 +32,11 @@ struct ParticleStore {
 
   std::size_t size() const { return id.size(); }
 
+  /// Incremented by every change of which particle sits in which slot (add,
+  /// swap_remove, permute), so that index-based structures (neighbour lists)
+  /// know they are stale without comparing ids every step.
+  std::uint64_t layout_version = 0;
+
   /// Append one particle at rest. Mass from density and radius.
   void add(std::uint64_t pid, double px, double py, double pz, double r, double density, bool fixed = false);
 

@@ -5,11 +5,21 @@
 #include "core/thread_pool.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 
 namespace domel::platform {
 
 namespace {
 constexpr int kSpin = 4000;
+}
+
+int default_thread_count() {
+  const char* env = std::getenv("DOMEL_THREADS");
+  if (env == nullptr || *env == '\0') return 1;
+  char* end = nullptr;
+  const long n = std::strtol(env, &end, 10);
+  if (*end != '\0' || n < 1 || n > 256) return 1;
+  return static_cast<int>(n);
 }
 
 ThreadPool::ThreadPool(int threads) : size_(std::max(1, threads)), errors_(static_cast<std::size_t>(size_)) {

@@ -22,6 +22,11 @@
 
 namespace domel::platform {
 
+/// The thread count used where neither the command line (--threads) nor the
+/// scenario (run.threads) sets one: the environment variable DOMEL_THREADS
+/// (an integer 1..256), else 1. Lets a whole test suite run threaded.
+int default_thread_count();
+
 class ThreadPool {
  public:
   explicit ThreadPool(int threads);

@@ -481,7 +481,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
 
   const json& run = doc["run"];
   sim->seed = run.value("seed", static_cast<std::uint64_t>(1));
-  sim->threads = run.value("threads", 1);
+  sim->threads = run.value("threads", 0);  // 0: not given (DOMEL_THREADS or 1)
 
   std::uint64_t next_id = 1;
   const json& sds = doc["subdomains"];

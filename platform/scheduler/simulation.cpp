@@ -47,7 +47,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
   std::filesystem::create_directories(out);
-  const int threads_requested = options.threads > 0 ? options.threads : threads;
+  const int threads_requested =
+      options.threads > 0 ? options.threads : (threads > 0 ? threads : default_thread_count());
 
   // Multi-rate: the macro step is the largest subdomain step; finer subdomains
   // sub-cycle with dt_k = macro / n_k (n_k rounded up, so no step grows).

@@ -49,7 +49,7 @@ class Simulation {
   double gravity[3] = {0, 0, -9.81};
   double duration = 0;
   std::uint64_t seed = 1;
-  int threads = 1;
+  int threads = 0;  ///< the scenario's run.threads; 0: not given (DOMEL_THREADS, else 1)
   double vtk_interval = 0;
   double probe_interval = 0;
   std::optional<ReposeProbeSettings> repose_probe;  ///< adds <subdomain>.repose_angle_deg to probes.csv

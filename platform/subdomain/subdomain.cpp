@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace domel::platform {
@@ -22,7 +23,7 @@ namespace domel::platform {
 Subdomain::Subdomain(std::string name, double coarse_grain, std::size_t material,
                      std::unique_ptr<ContactPipeline> pipeline)
     : name_(std::move(name)), coarse_grain_(coarse_grain), material_(material), pipeline_(std::move(pipeline)) {
-  set_threads(1);
+  set_threads(default_thread_count());
 }
 
 void Subdomain::set_threads(int threads) {
@@ -156,32 +157,95 @@ void Subdomain::rebuild_lists() {
     if (time_ < (*walls_)[w].remove_at) wall_lists_[w].build(store_, (*walls_)[w], skin_, pipeline_->history_stride());
 }
 
+namespace {
+// The integration passes as free functions: GCC honours __restrict on
+// parameters (not on local pointers), and with ~20 arrays the alias checks it
+// would otherwise need exceed its versioning limit, so the loops would stay
+// scalar. With restrict parameters both passes vectorise.
+
+/// Pass 1 of a step, fused: half kick, drift, displacement since the last list
+/// build (kCheck), and the force/torque reset to gravity. Returns the number of
+/// particles that moved farther than sqrt(limit2) (a sum of 0/1 in double:
+/// GCC 12 vectorises it, but not a floating-point max without -ffast-math,
+/// nor an integer OR of a double comparison).
+template <bool kCheck>
+double kick_drift_reset(std::size_t first, std::size_t last, double dt, double half, const double g[3],
+                        double* __restrict x, double* __restrict y, double* __restrict z, double* __restrict vx,
+                        double* __restrict vy, double* __restrict vz, double* __restrict wx, double* __restrict wy,
+                        double* __restrict wz, double* __restrict fx, double* __restrict fy, double* __restrict fz,
+                        double* __restrict tx, double* __restrict ty, double* __restrict tz,
+                        const double* __restrict im, const double* __restrict ii, const double* __restrict m,
+                        uint32_t* __restrict contacts, const double* __restrict x0, const double* __restrict y0,
+                        const double* __restrict z0, double limit2, const double* __restrict r,
+                        double* __restrict xr) {
+  const double g0 = g[0], g1 = g[1], g2 = g[2];
+  double far = 0.0;
+  for (std::size_t k = first; k < last; ++k) {
+    const double hm = half * im[k], hi = half * ii[k];
+    vx[k] += hm * fx[k]; vy[k] += hm * fy[k]; vz[k] += hm * fz[k];
+    wx[k] += hi * tx[k]; wy[k] += hi * ty[k]; wz[k] += hi * tz[k];
+    x[k] += dt * vx[k]; y[k] += dt * vy[k]; z[k] += dt * vz[k];
+    xr[4 * k] = x[k]; xr[4 * k + 1] = y[k]; xr[4 * k + 2] = z[k]; xr[4 * k + 3] = r[k];
+    if constexpr (kCheck) {
+      const double dx = x[k] - x0[k], dy = y[k] - y0[k], dz = z[k] - z0[k];
+      far += (dx * dx + dy * dy + dz * dz > limit2) ? 1.0 : 0.0;
+    }
+    fx[k] = m[k] * g0; fy[k] = m[k] * g1; fz[k] = m[k] * g2;
+    tx[k] = 0.0; ty[k] = 0.0; tz[k] = 0.0;
+    contacts[k] = 0;
+  }
+  return far;
+}
+
+/// Pass 2: the second half kick, and a finiteness check that costs no
+/// branch: !(|x + y + ... | <= max) holds for inf and NaN. Returns the count
+/// of non-finite particles.
+double kick_check(std::size_t first, std::size_t last, double half, const double* __restrict x,
+                  const double* __restrict y, const double* __restrict z, double* __restrict vx,
+                  double* __restrict vy, double* __restrict vz, double* __restrict wx, double* __restrict wy,
+                  double* __restrict wz, const double* __restrict fx, const double* __restrict fy,
+                  const double* __restrict fz, const double* __restrict tx, const double* __restrict ty,
+                  const double* __restrict tz, const double* __restrict im, const double* __restrict ii) {
+  constexpr double kMax = std::numeric_limits<double>::max();
+  double bad = 0.0;
+  for (std::size_t k = first; k < last; ++k) {
+    const double hm = half * im[k], hi = half * ii[k];
+    vx[k] += hm * fx[k]; vy[k] += hm * fy[k]; vz[k] += hm * fz[k];
+    wx[k] += hi * tx[k]; wy[k] += hi * ty[k]; wz[k] += hi * tz[k];
+    bad += (std::fabs(x[k] + y[k] + z[k] + vx[k] + vy[k] + vz[k]) <= kMax) ? 0.0 : 1.0;
+  }
+  return bad;
+}
+}  // namespace
+
 void Subdomain::step() {
   const std::size_t n = store_.size();
   const double dt = dt_, half = 0.5 * dt_;
   ParticleStore& s = store_;
-  pool_->for_range(n, [&](std::size_t first, std::size_t last, int) {
-    for (std::size_t k = first; k < last; ++k) {
-      const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
-      s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
-      s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
-      s.x[k] += dt * s.vx[k]; s.y[k] += dt * s.vy[k]; s.z[k] += dt * s.vz[k];
-    }
-  });
-  if (nlist_.needs_rebuild(s)) rebuild_lists();
-  compute_forces();
-  std::vector<char> finite_part(static_cast<std::size_t>(threads()), 1);
+  const int nt = threads();
+  std::vector<double>& partial = partial_;
+  partial.assign(static_cast<std::size_t>(nt), 0.0);
+  xr_.resize(4 * n);
+  // Pass 1 (one sweep over the store instead of the four of a textbook
+  // step: kick-drift, rebuild check, force reset; docs/performance.md).
+  const bool stale = nlist_.layout_stale(s);
   pool_->for_range(n, [&](std::size_t first, std::size_t last, int t) {
-    bool ok = true;
-    for (std::size_t k = first; k < last; ++k) {
-      const double hm = half * s.inv_mass[k], hi = half * s.inv_inertia[k];
-      s.vx[k] += hm * s.fx[k]; s.vy[k] += hm * s.fy[k]; s.vz[k] += hm * s.fz[k];
-      s.wx[k] += hi * s.tx[k]; s.wy[k] += hi * s.ty[k]; s.wz[k] += hi * s.tz[k];
-      ok = ok && std::isfinite(s.x[k] + s.y[k] + s.z[k] + s.vx[k] + s.vy[k] + s.vz[k]);
-    }
-    finite_part[static_cast<std::size_t>(t)] = ok;
+    auto pass = stale ? &kick_drift_reset<false> : &kick_drift_reset<true>;
+    partial[static_cast<std::size_t>(t)] =
+        pass(first, last, dt, half, gravity_, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(),
+             s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
+             s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data(), s.mass.data(), s.contacts.data(),
+             nlist_.x0(), nlist_.y0(), nlist_.z0(), nlist_.rebuild_displacement2(), s.radius.data(), xr_.data());
   });
-  const bool finite = std::all_of(finite_part.begin(), finite_part.end(), [](char c) { return c != 0; });
+  if (stale || std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) rebuild_lists();
+  contact_forces();
+  pool_->for_range(n, [&](std::size_t first, std::size_t last, int t) {
+    partial[static_cast<std::size_t>(t)] =
+        kick_check(first, last, half, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
+                   s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
+                   s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data());
+  });
+  const bool finite = std::none_of(partial.begin(), partial.end(), [](double p) { return p != 0.0; });
   time_ += dt;
   ++steps_;
   if (!finite) {
@@ -194,8 +258,10 @@ void Subdomain::step() {
 
 void Subdomain::compute_forces() {
   ParticleStore& s = store_;
+  xr_.resize(4 * s.size());
   pool_->for_range(s.size(), [&](std::size_t first, std::size_t last, int) {
     for (std::size_t k = first; k < last; ++k) {
+      xr_[4 * k] = s.x[k]; xr_[4 * k + 1] = s.y[k]; xr_[4 * k + 2] = s.z[k]; xr_[4 * k + 3] = s.radius[k];
       s.fx[k] = s.mass[k] * gravity_[0];
       s.fy[k] = s.mass[k] * gravity_[1];
       s.fz[k] = s.mass[k] * gravity_[2];
@@ -203,6 +269,10 @@ void Subdomain::compute_forces() {
       s.contacts[k] = 0;
     }
   });
+  contact_forces();
+}
+
+void Subdomain::contact_forces() {
   last_max_overlap_ratio_ = 0;
   pair_forces();
   wall_forces();
@@ -222,6 +292,7 @@ void Subdomain::pair_forces() {
     // store; the others into their own arrays, summed below in thread order:
     // the same floating-point sums every run for a given thread count.
     const std::size_t n = s.size();
+    balance_pairs(nt);
     pool_->run([&](int t) {
       ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
       Accumulator acc = direct;
@@ -231,8 +302,7 @@ void Subdomain::pair_forces() {
         acc = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data(),
                ts.contacts.data()};
       }
-      const auto r = pool_->range(npairs, t);
-      pair_range(r.first, r.second, ts, acc);
+      pair_range(split_[static_cast<std::size_t>(t)], split_[static_cast<std::size_t>(t) + 1], ts, acc);
     });
     pool_->for_range(n, [&](std::size_t first, std::size_t last, int) {
       for (std::size_t k = first; k < last; ++k)
@@ -251,83 +321,180 @@ void Subdomain::pair_forces() {
   }
 }
 
+namespace {
+// History rows are a few doubles (3 for Mindlin, 6 with a rolling model):
+// copy them inline; std::copy_n becomes a memmove call that costs more than
+// the copy itself at these sizes (perf: 6 % of a settle step).
+inline void copy_row(const double* __restrict src, double* __restrict dst, uint32_t n) {
+  switch (n) {
+    case 0: return;
+    case 1: dst[0] = src[0]; return;
+    case 2: dst[0] = src[0]; dst[1] = src[1]; return;
+    case 3: dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; return;
+    case 4: dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; dst[3] = src[3]; return;
+    case 5: dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; dst[3] = src[3]; dst[4] = src[4]; return;
+    case 6:
+      dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; dst[3] = src[3]; dst[4] = src[4]; dst[5] = src[5];
+      return;
+    default: std::copy_n(src, n, dst);
+  }
+}
+}  // namespace
+
+void Subdomain::balance_pairs(int nt) {
+  // Contiguous ranges of the pair list with near-equal estimated cost: an
+  // entry costs 1 (the overlap screen) and a contact kContactCost more (the
+  // contact kernels and the scatter; a perf profile of S1 at 50k gave 8 as the better balance than 4). Even entry
+  // counts leave the thread with the dense, settled bottom of a column with
+  // most of the work. The split depends only on the list and its contact
+  // flags, never on timings, so a run is bit-identical for a given thread
+  // count. Recomputed every kBalanceEvery steps and after each list build.
+  constexpr uint64_t kContactCost = 8;
+  constexpr std::uint64_t kBalanceEvery = 8;
+  const std::size_t npairs = nlist_.size();
+  if (split_.size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds() &&
+      steps_ % kBalanceEvery != 0)
+    return;
+  split_.assign(static_cast<std::size_t>(nt) + 1, npairs);
+  split_[0] = 0;
+  const uint8_t* touching = nlist_.touching.data();
+  uint64_t total = npairs;
+  for (std::size_t e = 0; e < npairs; ++e) total += kContactCost * touching[e];
+  uint64_t run = 0;
+  int t = 1;
+  for (std::size_t e = 0; e < npairs && t < nt; ++e) {
+    run += 1 + kContactCost * touching[e];
+    while (t < nt && run * static_cast<uint64_t>(nt) >= total * static_cast<uint64_t>(t)) split_[t++] = e + 1;
+  }
+  split_builds_ = nlist_.builds();
+}
+
 void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc) {
   const ParticleStore& s = store_;
   auto& buf = ts.ws->buf;
   const uint32_t stride = nlist_.stride();
   std::size_t contacts = 0;
   double max_ratio = 0.0;
-  uint32_t c = 0;
 
-  auto flush = [&]() {
-    if (c == 0) return;
-    pipeline_->evaluate(*ts.ws, self_pair_, dt_, c);
+  const uint32_t* __restrict li = nlist_.i.data();
+  const uint32_t* __restrict lj = nlist_.j.data();
+  uint8_t* __restrict touching = nlist_.touching.data();
+  double* __restrict list_history = nlist_.history.data();
+  // Positions and radii packed per particle (x, y, z, r): one cache line per
+  // partner instead of four in the screening loop below.
+  const double* __restrict xr = xr_.data();
+  const double* __restrict pvx = s.vx.data(); const double* __restrict pvy = s.vy.data();
+  const double* __restrict pvz = s.vz.data();
+  const double* __restrict pwx = s.wx.data(); const double* __restrict pwy = s.wy.data();
+  const double* __restrict pwz = s.wz.data();
+  const double* __restrict pm = s.mass.data();
+  uint32_t* __restrict entry = ts.entry.data();
+  double* __restrict lever_i = ts.ci.data();
+  double* __restrict lever_j = ts.cj.data();
+  double* __restrict b_overlap = buf.overlap.data();
+  double* __restrict b_nx = buf.nx.data(); double* __restrict b_ny = buf.ny.data();
+  double* __restrict b_nz = buf.nz.data();
+  double* __restrict b_ri = buf.radius_i.data(); double* __restrict b_rj = buf.radius_j.data();
+  double* __restrict b_reff = buf.r_eff.data(); double* __restrict b_meff = buf.m_eff.data();
+  double* __restrict b_vn = buf.vn.data();
+  double* __restrict b_vtx = buf.vtx.data(); double* __restrict b_vty = buf.vty.data();
+  double* __restrict b_vtz = buf.vtz.data();
+  double* __restrict b_wx = buf.wx.data(); double* __restrict b_wy = buf.wy.data();
+  double* __restrict b_wz = buf.wz.data();
+  double* __restrict b_hist = buf.history.data();
+  constexpr uint32_t kBatch = ContactPipeline::kBatchSize;
+
+  std::size_t e = first;
+  while (e < last) {
+    // Phase A: screen list entries for overlap, branch-free except for the
+    // rare contact that just opened, until a batch is full. Most entries of a
+    // Verlet list are not in contact (S1: ~5 of 6), so a data-dependent
+    // branch here mispredicts often.
+    uint32_t c = 0;
+    for (; e < last && c < kBatch; ++e) {
+      const double* pi = xr + 4 * static_cast<std::size_t>(li[e]);
+      const double* pj = xr + 4 * static_cast<std::size_t>(lj[e]);
+      const double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
+      const double rsum = pi[3] + pj[3];
+      const uint32_t in = (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
+      if (touching[e] > in) {  // the contact opened: its history ends
+        touching[e] = 0;
+        for (uint32_t h = 0; h < stride; ++h) list_history[e * stride + h] = 0.0;
+      }
+      entry[c] = static_cast<uint32_t>(e);
+      c += in;
+    }
+    if (c == 0) continue;
+    // Phase B: contact geometry and relative velocities of the batch.
     for (uint32_t q = 0; q < c; ++q) {
-      const uint32_t e = ts.entry[q];
-      const uint32_t i = nlist_.i[e], j = nlist_.j[e];
-      const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
-      const double fn = buf.fn[q];
-      const double ftx = buf.ftx[q], fty = buf.fty[q], ftz = buf.ftz[q];
+      const uint32_t le = entry[q];
+      const uint32_t i = li[le], j = lj[le];
+      const double* pi = xr + 4 * static_cast<std::size_t>(i);
+      const double* pj = xr + 4 * static_cast<std::size_t>(j);
+      const double ri = pi[3], rj = pj[3];
+      const double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
+      const double rsum = ri + rj;
+      const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double inv = 1.0 / dist;
+      const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+      const double delta = rsum - dist;
+      const double ci = ri - 0.5 * delta, cj = rj - 0.5 * delta;
+      // contact-point velocities: v_i + w_i x (-ci n) and v_j + w_j x (cj n)
+      const double wix = pwx[i], wiy = pwy[i], wiz = pwz[i];
+      const double wjx = pwx[j], wjy = pwy[j], wjz = pwz[j];
+      const double vix = pvx[i] - ci * (wiy * nz - wiz * ny);
+      const double viy = pvy[i] - ci * (wiz * nx - wix * nz);
+      const double viz = pvz[i] - ci * (wix * ny - wiy * nx);
+      const double vjx = pvx[j] + cj * (wjy * nz - wjz * ny);
+      const double vjy = pvy[j] + cj * (wjz * nx - wjx * nz);
+      const double vjz = pvz[j] + cj * (wjx * ny - wjy * nx);
+      const double rx = vix - vjx, ry = viy - vjy, rz = viz - vjz;
+      const double vdotn = rx * nx + ry * ny + rz * nz;
+      b_overlap[q] = delta;
+      b_nx[q] = nx; b_ny[q] = ny; b_nz[q] = nz;
+      b_ri[q] = ri;
+      b_rj[q] = rj;
+      b_reff[q] = ri * rj / rsum;
+      b_meff[q] = pm[i] * pm[j] / (pm[i] + pm[j]);
+      b_vn[q] = -vdotn;
+      b_vtx[q] = rx - vdotn * nx; b_vty[q] = ry - vdotn * ny; b_vtz[q] = rz - vdotn * nz;
+      b_wx[q] = wix - wjx; b_wy[q] = wiy - wjy; b_wz[q] = wiz - wjz;
+      copy_row(list_history + static_cast<std::size_t>(le) * stride, b_hist + static_cast<std::size_t>(q) * stride,
+               stride);
+      touching[le] = 1;
+      lever_i[q] = ci;
+      lever_j[q] = cj;
+      max_ratio = std::max(max_ratio, delta / rsum);
+    }
+    pipeline_->evaluate(*ts.ws, self_pair_, dt_, c);
+    // Scatter: forces and torques onto both particles, history back to the list.
+    const double* __restrict fn_ = buf.fn.data();
+    const double* __restrict ftx_ = buf.ftx.data(); const double* __restrict fty_ = buf.fty.data();
+    const double* __restrict ftz_ = buf.ftz.data();
+    const double* __restrict tqx_ = buf.tqx.data(); const double* __restrict tqy_ = buf.tqy.data();
+    const double* __restrict tqz_ = buf.tqz.data();
+    for (uint32_t q = 0; q < c; ++q) {
+      const uint32_t le = entry[q];
+      const uint32_t i = li[le], j = lj[le];
+      const double nx = b_nx[q], ny = b_ny[q], nz = b_nz[q];
+      const double fn = fn_[q];
+      const double ftx = ftx_[q], fty = fty_[q], ftz = ftz_[q];
       const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
       acc.fx[i] += fx; acc.fy[i] += fy; acc.fz[i] += fz;
       acc.fx[j] -= fx; acc.fy[j] -= fy; acc.fz[j] -= fz;
       // n x F_t
       const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
-      const double ci = ts.ci[q], cj = ts.cj[q];
-      acc.tx[i] += -ci * cx + buf.tqx[q]; acc.ty[i] += -ci * cy + buf.tqy[q]; acc.tz[i] += -ci * cz + buf.tqz[q];
-      acc.tx[j] += -cj * cx - buf.tqx[q]; acc.ty[j] += -cj * cy - buf.tqy[q]; acc.tz[j] += -cj * cz - buf.tqz[q];
+      const double ci = lever_i[q], cj = lever_j[q];
+      const double mx = tqx_[q], my = tqy_[q], mz = tqz_[q];
+      acc.tx[i] += -ci * cx + mx; acc.ty[i] += -ci * cy + my; acc.tz[i] += -ci * cz + mz;
+      acc.tx[j] += -cj * cx - mx; acc.ty[j] += -cj * cy - my; acc.tz[j] += -cj * cz - mz;
       ++acc.contacts[i];
       ++acc.contacts[j];
-      if (stride) std::copy_n(buf.history.begin() + q * stride, stride, nlist_.history.begin() + e * stride);
+      copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
+               stride);
     }
     contacts += c;
-    c = 0;
-  };
-
-  for (std::size_t e = first; e < last; ++e) {
-    const uint32_t i = nlist_.i[e], j = nlist_.j[e];
-    const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
-    const double rsum = s.radius[i] + s.radius[j];
-    const double d2 = dx * dx + dy * dy + dz * dz;
-    if (d2 >= rsum * rsum) {
-      if (nlist_.touching[e]) {
-        nlist_.touching[e] = 0;
-        std::fill_n(nlist_.history.begin() + e * stride, stride, 0.0);
-      }
-      continue;
-    }
-    const double dist = std::sqrt(d2);
-    const double inv = 1.0 / dist;
-    const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
-    const double delta = rsum - dist;
-    const double ci = s.radius[i] - 0.5 * delta, cj = s.radius[j] - 0.5 * delta;
-    // contact-point velocities: v_i + w_i x (-ci n) and v_j + w_j x (cj n)
-    const double vix = s.vx[i] - ci * (s.wy[i] * nz - s.wz[i] * ny);
-    const double viy = s.vy[i] - ci * (s.wz[i] * nx - s.wx[i] * nz);
-    const double viz = s.vz[i] - ci * (s.wx[i] * ny - s.wy[i] * nx);
-    const double vjx = s.vx[j] + cj * (s.wy[j] * nz - s.wz[j] * ny);
-    const double vjy = s.vy[j] + cj * (s.wz[j] * nx - s.wx[j] * nz);
-    const double vjz = s.vz[j] + cj * (s.wx[j] * ny - s.wy[j] * nx);
-    const double rx = vix - vjx, ry = viy - vjy, rz = viz - vjz;
-    const double vdotn = rx * nx + ry * ny + rz * nz;
-    buf.overlap[c] = delta;
-    buf.nx[c] = nx; buf.ny[c] = ny; buf.nz[c] = nz;
-    buf.radius_i[c] = s.radius[i];
-    buf.radius_j[c] = s.radius[j];
-    buf.r_eff[c] = s.radius[i] * s.radius[j] / rsum;
-    buf.m_eff[c] = s.mass[i] * s.mass[j] / (s.mass[i] + s.mass[j]);
-    buf.vn[c] = -vdotn;
-    buf.vtx[c] = rx - vdotn * nx; buf.vty[c] = ry - vdotn * ny; buf.vtz[c] = rz - vdotn * nz;
-    buf.wx[c] = s.wx[i] - s.wx[j]; buf.wy[c] = s.wy[i] - s.wy[j]; buf.wz[c] = s.wz[i] - s.wz[j];
-    if (stride) std::copy_n(nlist_.history.begin() + e * stride, stride, buf.history.begin() + c * stride);
-    nlist_.touching[e] = 1;
-    ts.entry[c] = static_cast<uint32_t>(e);
-    ts.ci[c] = ci;
-    ts.cj[c] = cj;
-    max_ratio = std::max(max_ratio, delta / rsum);
-    if (++c == ContactPipeline::kBatchSize) flush();
   }
-  flush();
   ts.n_contacts = contacts;
   ts.max_ratio = max_ratio;
 }
@@ -361,7 +528,7 @@ void Subdomain::wall_forces() {
         const double ci = ts.ci[q];
         s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
         ++s.contacts[i];
-        if (stride) std::copy_n(buf.history.begin() + q * stride, stride, list.history.begin() + e * stride);
+        copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
       }
       contacts += c;
       c = 0;
@@ -392,7 +559,7 @@ void Subdomain::wall_forces() {
       buf.vn[c] = -vdotn;
       buf.vtx[c] = rx - vdotn * nx; buf.vty[c] = ry - vdotn * ny; buf.vtz[c] = rz - vdotn * nz;
       buf.wx[c] = s.wx[i]; buf.wy[c] = s.wy[i]; buf.wz[c] = s.wz[i];
-      if (stride) std::copy_n(list.history.begin() + e * stride, stride, buf.history.begin() + c * stride);
+      copy_row(list.history.data() + e * stride, buf.history.data() + c * stride, stride);
       list.touching[e] = 1;
       ts.entry[c] = static_cast<uint32_t>(e);
       ts.ci[c] = ci;

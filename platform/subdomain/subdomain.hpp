@@ -107,8 +107,10 @@ class Subdomain {
   };
 
   void rebuild_lists();
-  void compute_forces();
+  void compute_forces();   ///< reset to gravity, then contact_forces()
+  void contact_forces();   ///< add particle-pair and wall contact forces
   void pair_forces();
+  void balance_pairs(int nt);
   void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc);
   void wall_forces();
 
@@ -131,6 +133,10 @@ class Subdomain {
   std::size_t last_contacts_ = 0, last_wall_contacts_ = 0;
   double last_max_overlap_ratio_ = 0;
   std::vector<ThreadScratch> scratch_;
+  std::vector<double> partial_;
+  std::vector<std::size_t> split_;  ///< pair-list ranges of the threads (balance_pairs)
+  std::size_t split_builds_ = 0;
+  std::vector<double> xr_;  ///< packed (x, y, z, radius) per particle, refreshed by every drift  ///< per-thread partial results of the integration passes
   std::unique_ptr<ThreadPool> pool_;
 };
 

@@ -30,13 +30,20 @@ class Hertz {
 
   void compute(domel_contact_batch_v1& b) const {
     const double e_eff = b.pair->youngs_eff;
-    for (uint32_t c = 0; c < b.n; ++c) {
-      const double a = std::sqrt(b.r_eff[c] * b.overlap[c]);
+    const uint32_t n = b.n;
+    const double* __restrict r_eff = b.r_eff;
+    const double* __restrict overlap = b.overlap;
+    double* __restrict radius = b.contact_radius;
+    double* __restrict kn = b.kn;
+    double* __restrict kn_tangent = b.kn_tangent;
+    double* __restrict fn_elastic = b.fn_elastic;
+    for (uint32_t c = 0; c < n; ++c) {
+      const double a = std::sqrt(r_eff[c] * overlap[c]);
       const double k = (4.0 / 3.0) * e_eff * a;
-      b.contact_radius[c] = a;
-      b.kn[c] = k;
-      b.kn_tangent[c] = 1.5 * k;  // dF/d delta = 2 E* a
-      b.fn_elastic[c] = k * b.overlap[c];
+      radius[c] = a;
+      kn[c] = k;
+      kn_tangent[c] = 1.5 * k;  // dF/d delta = 2 E* a
+      fn_elastic[c] = k * overlap[c];
     }
   }
 };
