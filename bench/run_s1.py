@@ -176,15 +176,16 @@ def scenario_file(n, workdir):
     return path
 
 
-def run_domel(domel, n, rep, workdir, timeout, env):
+def run_domel(domel, n, rep, workdir, timeout, env, threads=1):
     nx, ny, nz = make_s1.lattice_dims(n)
     expected = nx * ny * nz
-    outdir = os.path.join(workdir, "domel_N%d_r%d" % (n, rep))
+    code = "domel" if threads == 1 else "domel_%dt" % threads
+    outdir = os.path.join(workdir, "%s_N%d_r%d" % (code, n, rep))
     log = outdir + ".screen"
-    row = {"code": "domel", "N_requested": n, "rep": rep, "log": log}
+    row = {"code": code, "N_requested": n, "rep": rep, "log": log}
     row["load1_start"] = load1()
     rc, wall, cpu, samples = run_timed([domel, "run", scenario_file(n, workdir), "--out", outdir, "--quiet",
-                               "--time-after", str(NSETTLE)], workdir, log, timeout, env)
+                               "--time-after", str(NSETTLE), "--threads", str(threads)], workdir, log, timeout, env)
     row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)
     summary_path = os.path.join(outdir, "summary.json")
     if rc != 0 or not os.path.isfile(summary_path):
@@ -309,6 +310,23 @@ def print_tables(rows, sizes, have_peer):
           "load = 1-min load average at the start of the runs")
     print_md(head, lines)
 
+    threaded = sorted({r["code"] for r in rows if r["code"].startswith("domel_")})
+    if threaded:
+        print()
+        print("domel with worker threads (wall-clock, timed steps) against serial LIGGGHTS; speed-up = over domel on "
+              "1 thread in the same invocation")
+        tl = []
+        for code in threaded:
+            for n in sizes:
+                mine = [r for r in rows if r["N_requested"] == n]
+                dt_ = stats([r.get("particle_steps_per_s") for r in mine if r["code"] == code and r.get("ok")])
+                d1 = stats([r.get("particle_steps_per_s") for r in mine if r["code"] == "domel" and r.get("ok")])
+                p = stats([r.get("particle_steps_per_s") for r in mine if r["code"] == "liggghts" and r.get("ok")])
+                nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), n)
+                tl.append([code, str(nact), fmt_rate(dt_), "%.2f" % (dt_[0] / d1[0]) if dt_ and d1 else "-",
+                           "%.2f" % (dt_[0] / p[0]) if dt_ and p else "-"])
+        print_md(["domel", "N", "median [min-max]", "speed-up", "ratio domel/LIGGGHTS serial"], tl)
+
     print()
     print("Per CPU-second of the timed steps (robust to time-slicing on a loaded machine): LIGGGHTS from the "
           "deck's cpusec.sh lines, domel from /proc samples of its last timed_wall seconds; "
@@ -402,6 +420,8 @@ def main(argv=None):
     ap.add_argument("--peers", default=default_peers(), help="peers folder with liggghts/settle.in and cpusec.sh")
     ap.add_argument("--timeout", type=float, default=900, help="per-run timeout in s (default 900)")
     ap.add_argument("--results", default=os.path.join(HERE, "results"), help="CSV folder (default bench/results)")
+    ap.add_argument("--threads", type=int, nargs="+", default=[1],
+                    help="domel thread counts to run (default 1; e.g. --threads 1 2); LIGGGHTS always runs serially")
     ap.add_argument("--report", metavar="CSV", help="only print the tables of an earlier run's CSV, run nothing")
     ap.add_argument("--workdir", help="where logs and domel outputs go (default: a fresh temp dir, kept)")
     args = ap.parse_args(argv)
@@ -415,6 +435,10 @@ def main(argv=None):
         sizes.append(200000)
     if reps < 1 or any(n < 2 for n in sizes):
         ap.error("--reps must be >= 1 and every size >= 2")
+    if args.domel:
+        args.domel = os.path.abspath(args.domel) if os.sep in args.domel else args.domel
+    if any(t < 1 for t in args.threads):
+        ap.error("--threads expects counts >= 1")
     if not args.domel or not os.access(args.domel, os.X_OK):
         ap.error("no domel binary (build it: cmake -S . -B build-bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
                  "-DDOMEL_BUILD_TESTS=OFF && cmake --build build-bench), or pass --domel")
@@ -456,7 +480,8 @@ def main(argv=None):
         w.writeheader()
         for n in sizes:
             for rep in range(1, reps + 1):
-                jobs = [("domel", lambda: run_domel(args.domel, n, rep, workdir, args.timeout, env))]
+                jobs = [("domel", lambda t=t: run_domel(args.domel, n, rep, workdir, args.timeout, env, t))
+                        for t in args.threads]
                 if have_peer:
                     jobs.append(("liggghts", lambda: run_liggghts(args.liggghts, deckdir, n, rep, workdir,
                                                                   args.timeout, env)))
