@@ -114,6 +114,27 @@ void NeighborList::build(const ParticleStore& s) {
       }
     }
   }
+  // Tiers: near entries first, far after, each in build order (stable).
+  {
+    const double h = near_gap();
+    std::vector<uint32_t> ti, tj;
+    ti.reserve(i.size());
+    tj.reserve(j.size());
+    for (int pass = 0; pass < 2; ++pass) {
+      for (std::size_t k = 0; k < i.size(); ++k) {
+        const uint32_t a = i[k], b = j[k];
+        const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
+        const double gap = std::sqrt(ddx * ddx + ddy * ddy + ddz * ddz) - s.radius[a] - s.radius[b];
+        if ((gap < h) == (pass == 0)) {
+          ti.push_back(a);
+          tj.push_back(b);
+        }
+      }
+      if (pass == 0) near_size_ = ti.size();
+    }
+    i.swap(ti);
+    j.swap(tj);
+  }
   history.assign(i.size() * stride_, 0.0);
   touching.assign(i.size(), 0);
   if (!old.empty() && stride_ > 0) {

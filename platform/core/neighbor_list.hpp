@@ -38,6 +38,17 @@ class NeighborList {
   const double* y0() const { return y0_.data(); }
   const double* z0() const { return z0_.data(); }
   double rebuild_displacement2() const { return 0.25 * skin_ * skin_; }
+
+  /// Two tiers (docs/performance.md): entries [0, near_size()) had a gap
+  /// (distance minus radii) below near_gap() at the build, the rest at least
+  /// near_gap(). A far entry can only touch once some particle has moved
+  /// more than near_gap()/2 since the build (two particles close a gap by at
+  /// most twice the largest displacement), so until then only the near tier
+  /// needs the overlap screen. Within each tier entries keep build order.
+  std::size_t near_size() const { return near_size_; }
+  double near_gap() const { return kNearFraction * skin_; }
+  double far_tier_displacement2() const { return 0.25 * near_gap() * near_gap(); }
+  static constexpr double kNearFraction = 0.5;
   void build(const ParticleStore& s);
   std::size_t size() const { return i.size(); }
   std::size_t builds() const { return builds_; }
@@ -54,6 +65,7 @@ class NeighborList {
   std::vector<std::uint64_t> built_ids_;  ///< ids at the last build (history carry-over)
   std::size_t built_size_ = 0;
   std::uint64_t built_version_ = 0;
+  std::size_t near_size_ = 0;
 };
 
 }  // namespace domel::platform

@@ -153,6 +153,7 @@ void Subdomain::setup() {
 
 void Subdomain::rebuild_lists() {
   nlist_.build(store_);
+  far_active_ = false;
   for (std::size_t w = 0; w < wall_lists_.size(); ++w)
     if (time_ < (*walls_)[w].remove_at) wall_lists_[w].build(store_, (*walls_)[w], skin_, pipeline_->history_stride());
 }
@@ -176,10 +177,10 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
                         double* __restrict tx, double* __restrict ty, double* __restrict tz,
                         const double* __restrict im, const double* __restrict ii, const double* __restrict m,
                         uint32_t* __restrict contacts, const double* __restrict x0, const double* __restrict y0,
-                        const double* __restrict z0, double limit2, const double* __restrict r,
-                        double* __restrict xr) {
+                        const double* __restrict z0, double limit2, double limit2_far,
+                        double& far_tier, const double* __restrict r, double* __restrict xr) {
   const double g0 = g[0], g1 = g[1], g2 = g[2];
-  double far = 0.0;
+  double far = 0.0, tier = 0.0;
   for (std::size_t k = first; k < last; ++k) {
     const double hm = half * im[k], hi = half * ii[k];
     vx[k] += hm * fx[k]; vy[k] += hm * fy[k]; vz[k] += hm * fz[k];
@@ -188,12 +189,15 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
     xr[4 * k] = x[k]; xr[4 * k + 1] = y[k]; xr[4 * k + 2] = z[k]; xr[4 * k + 3] = r[k];
     if constexpr (kCheck) {
       const double dx = x[k] - x0[k], dy = y[k] - y0[k], dz = z[k] - z0[k];
-      far += (dx * dx + dy * dy + dz * dz > limit2) ? 1.0 : 0.0;
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      far += (d2 > limit2) ? 1.0 : 0.0;
+      tier += (d2 > limit2_far) ? 1.0 : 0.0;
     }
     fx[k] = m[k] * g0; fy[k] = m[k] * g1; fz[k] = m[k] * g2;
     tx[k] = 0.0; ty[k] = 0.0; tz[k] = 0.0;
     contacts[k] = 0;
   }
+  far_tier = tier;
   return far;
 }
 
@@ -225,6 +229,8 @@ void Subdomain::step() {
   const int nt = threads();
   std::vector<double>& partial = partial_;
   partial.assign(static_cast<std::size_t>(nt), 0.0);
+  std::vector<double>& tier = tier_partial_;
+  tier.assign(static_cast<std::size_t>(nt), 0.0);
   xr_.resize(4 * n);
   // Pass 1 (one sweep over the store instead of the four of a textbook
   // step: kick-drift, rebuild check, force reset; docs/performance.md).
@@ -235,11 +241,21 @@ void Subdomain::step() {
         pass(first, last, dt, half, gravity_, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(),
              s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
              s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data(), s.mass.data(), s.contacts.data(),
-             nlist_.x0(), nlist_.y0(), nlist_.z0(), nlist_.rebuild_displacement2(), s.radius.data(), xr_.data());
+             nlist_.x0(), nlist_.y0(), nlist_.z0(), nlist_.rebuild_displacement2(),
+             nlist_.far_tier_displacement2(), tier[static_cast<std::size_t>(t)], s.radius.data(), xr_.data());
   });
-  if (stale || std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) rebuild_lists();
-  contact_forces();
+  if (stale || std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) {
+    rebuild_lists();
+  } else if (std::any_of(tier.begin(), tier.end(), [](double f) { return f != 0.0; })) {
+    far_active_ = true;  // latched until the next build: far entries are screened from now on
+  }
+  contact_forces(true);
+  // Pass 2, with the other threads' force sums folded in (one sweep, one
+  // fork/join less than a separate reduction).
+  const bool reduce = reduce_pending_;
+  reduce_pending_ = false;
   pool_->for_range(n, [&](std::size_t first, std::size_t last, int t) {
+    if (reduce) reduce_partials(first, last);
     partial[static_cast<std::size_t>(t)] =
         kick_check(first, last, half, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
                    s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
@@ -272,52 +288,81 @@ void Subdomain::compute_forces() {
   contact_forces();
 }
 
-void Subdomain::contact_forces() {
+void Subdomain::contact_forces(bool defer_reduce) {
   last_max_overlap_ratio_ = 0;
-  pair_forces();
+  pair_forces(defer_reduce);
   wall_forces();
 }
 
-void Subdomain::pair_forces() {
+void Subdomain::pair_forces(bool defer_reduce) {
   ParticleStore& s = store_;
-  const std::size_t npairs = nlist_.size();
   const int nt = threads();
+  const bool far = far_active_;
   const Accumulator direct{s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data(),
                            s.contacts.data()};
+  for (auto& ts : scratch_) {
+    ts.n_contacts = 0;
+    ts.max_ratio = 0.0;
+  }
   if (nt == 1) {
-    pair_range(0, npairs, scratch_[0], direct);
+    pair_range(0, nlist_.near_size(), scratch_[0], direct);
+    if (far) pair_range(nlist_.near_size(), nlist_.size(), scratch_[0], direct);
   } else {
-    // Each thread owns a fixed, contiguous range of the pair list (so each
-    // list entry and its history has one writer). Thread 0 adds into the
-    // store; the others into their own arrays, summed below in thread order:
-    // the same floating-point sums every run for a given thread count.
+    // Each thread owns a fixed, contiguous range of each tier of the pair
+    // list (so each list entry and its history has one writer). Thread 0 adds
+    // into the store; the others into their own arrays, over the span of
+    // particle indices their pairs touch, summed in thread order
+    // (reduce_partials): the same floating-point sums every run for a given
+    // thread count.
     const std::size_t n = s.size();
     balance_pairs(nt);
     pool_->run([&](int t) {
-      ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+      const std::size_t q = static_cast<std::size_t>(t);
+      ThreadScratch& ts = scratch_[q];
       Accumulator acc = direct;
       if (t > 0) {
-        for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) v->assign(n, 0.0);
-        ts.contacts.assign(n, 0);
+        if (ts.contacts.size() != n) {
+          for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) v->assign(n, 0.0);
+          ts.contacts.assign(n, 0);
+        }
+        ts.lo = ts.span[0][0];
+        ts.hi = ts.span[0][1];
+        if (far && ts.span[1][1] > ts.span[1][0]) {
+          ts.lo = ts.hi > ts.lo ? std::min(ts.lo, ts.span[1][0]) : ts.span[1][0];
+          ts.hi = std::max(ts.hi, ts.span[1][1]);
+        }
+        const auto lo = static_cast<std::ptrdiff_t>(ts.lo), hi = static_cast<std::ptrdiff_t>(ts.hi);
+        for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) std::fill(v->begin() + lo, v->begin() + hi, 0.0);
+        std::fill(ts.contacts.begin() + lo, ts.contacts.begin() + hi, 0u);
         acc = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data(),
                ts.contacts.data()};
       }
-      pair_range(split_[static_cast<std::size_t>(t)], split_[static_cast<std::size_t>(t) + 1], ts, acc);
+      pair_range(split_[0][q], split_[0][q + 1], ts, acc);
+      if (far) pair_range(split_[1][q], split_[1][q + 1], ts, acc);
     });
-    pool_->for_range(n, [&](std::size_t first, std::size_t last, int) {
-      for (std::size_t k = first; k < last; ++k)
-        for (int t = 1; t < nt; ++t) {
-          const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
-          s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
-          s.tx[k] += ts.tx[k]; s.ty[k] += ts.ty[k]; s.tz[k] += ts.tz[k];
-          s.contacts[k] += ts.contacts[k];
-        }
-    });
+    if (defer_reduce) {
+      reduce_pending_ = true;  // step() folds the sums into its second half kick
+    } else {
+      pool_->for_range(n, [&](std::size_t first, std::size_t last, int) { reduce_partials(first, last); });
+    }
   }
   last_contacts_ = 0;
   for (const auto& ts : scratch_) {
     last_contacts_ += ts.n_contacts;
     last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.max_ratio);
+  }
+}
+
+void Subdomain::reduce_partials(std::size_t first, std::size_t last) {
+  ParticleStore& s = store_;
+  for (int t = 1; t < threads(); ++t) {
+    const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+    const std::size_t a = std::max(first, ts.lo), b = std::min(last, ts.hi);
+    for (std::size_t k = a; k < b; ++k) {
+      s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
+      s.tx[k] += ts.tx[k]; s.ty[k] += ts.ty[k]; s.tz[k] += ts.tz[k];
+      s.contacts[k] += ts.contacts[k];
+    }
   }
 }
 
@@ -342,29 +387,49 @@ inline void copy_row(const double* __restrict src, double* __restrict dst, uint3
 }  // namespace
 
 void Subdomain::balance_pairs(int nt) {
-  // Contiguous ranges of the pair list with near-equal estimated cost: an
-  // entry costs 1 (the overlap screen) and a contact kContactCost more (the
-  // contact kernels and the scatter; a perf profile of S1 at 50k gave 8 as the better balance than 4). Even entry
-  // counts leave the thread with the dense, settled bottom of a column with
-  // most of the work. The split depends only on the list and its contact
-  // flags, never on timings, so a run is bit-identical for a given thread
-  // count. Recomputed every kBalanceEvery steps and after each list build.
+  // Contiguous ranges of each tier of the pair list with near-equal estimated
+  // cost: an entry costs 1 (the overlap screen) and a contact kContactCost
+  // more (the contact kernels and the scatter; on S1 at 50k, 8 balanced the
+  // two threads better than 4). Even entry counts leave the thread with the
+  // dense, settled bottom of a column with most of the work. The split
+  // depends only on the list and its contact flags, never on timings, so a
+  // run is bit-identical for a given thread count. Recomputed every
+  // kBalanceEvery steps and after each list build.
   constexpr uint64_t kContactCost = 8;
   constexpr std::uint64_t kBalanceEvery = 8;
-  const std::size_t npairs = nlist_.size();
-  if (split_.size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds() &&
+  const std::size_t tiers[3] = {0, nlist_.near_size(), nlist_.size()};
+  if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds() &&
       steps_ % kBalanceEvery != 0)
     return;
-  split_.assign(static_cast<std::size_t>(nt) + 1, npairs);
-  split_[0] = 0;
   const uint8_t* touching = nlist_.touching.data();
-  uint64_t total = npairs;
-  for (std::size_t e = 0; e < npairs; ++e) total += kContactCost * touching[e];
-  uint64_t run = 0;
-  int t = 1;
-  for (std::size_t e = 0; e < npairs && t < nt; ++e) {
-    run += 1 + kContactCost * touching[e];
-    while (t < nt && run * static_cast<uint64_t>(nt) >= total * static_cast<uint64_t>(t)) split_[t++] = e + 1;
+  const uint32_t* li = nlist_.i.data();
+  const uint32_t* lj = nlist_.j.data();
+  for (int tier = 0; tier < 2; ++tier) {
+    const std::size_t begin = tiers[tier], end = tiers[tier + 1];
+    std::vector<std::size_t>& split = split_[tier];
+    split.assign(static_cast<std::size_t>(nt) + 1, end);
+    split[0] = begin;
+    uint64_t total = end - begin;
+    for (std::size_t e = begin; e < end; ++e) total += kContactCost * touching[e];
+    uint64_t run = 0;
+    int t = 1;
+    for (std::size_t e = begin; e < end && t < nt; ++e) {
+      run += 1 + kContactCost * touching[e];
+      while (t < nt && run * static_cast<uint64_t>(nt) >= total * static_cast<uint64_t>(t)) split[t++] = e + 1;
+    }
+    // The particle-index span each thread's pairs touch: the only part of its
+    // private force arrays to clear and to sum (after a list build in spatial
+    // order, a band rather than the whole store).
+    for (int q = 1; q < nt; ++q) {
+      ThreadScratch& ts = scratch_[static_cast<std::size_t>(q)];
+      std::size_t lo = store_.size(), hi = 0;
+      for (std::size_t e = split[static_cast<std::size_t>(q)]; e < split[static_cast<std::size_t>(q) + 1]; ++e) {
+        lo = std::min<std::size_t>(lo, std::min(li[e], lj[e]));
+        hi = std::max<std::size_t>(hi, std::max(li[e], lj[e]) + 1u);
+      }
+      ts.span[tier][0] = lo < hi ? lo : 0;
+      ts.span[tier][1] = lo < hi ? hi : 0;
+    }
   }
   split_builds_ = nlist_.builds();
 }
@@ -495,8 +560,8 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
     }
     contacts += c;
   }
-  ts.n_contacts = contacts;
-  ts.max_ratio = max_ratio;
+  ts.n_contacts += contacts;
+  ts.max_ratio = std::max(ts.max_ratio, max_ratio);
 }
 
 void Subdomain::wall_forces() {

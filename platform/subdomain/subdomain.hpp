@@ -98,6 +98,8 @@ class Subdomain {
     std::vector<double> fx, fy, fz, tx, ty, tz;  ///< accumulators (threads > 0)
     std::vector<uint32_t> contacts;
     std::size_t n_contacts = 0;
+    std::size_t lo = 0, hi = 0;      ///< particle-index span of this thread's pairs this step (threads > 0)
+    std::size_t span[2][2] = {{0, 0}, {0, 0}};  ///< the span per list tier (near, far)
     double max_ratio = 0;
   };
   /// Where a thread adds forces: the store itself (thread 0) or its own arrays.
@@ -108,8 +110,11 @@ class Subdomain {
 
   void rebuild_lists();
   void compute_forces();   ///< reset to gravity, then contact_forces()
-  void contact_forces();   ///< add particle-pair and wall contact forces
-  void pair_forces();
+  /// Add particle-pair and wall contact forces; with defer_reduce the other
+  /// threads' partial sums are left for the caller (reduce_partials).
+  void contact_forces(bool defer_reduce = false);
+  void pair_forces(bool defer_reduce);
+  void reduce_partials(std::size_t first, std::size_t last);
   void balance_pairs(int nt);
   void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc);
   void wall_forces();
@@ -134,8 +139,11 @@ class Subdomain {
   double last_max_overlap_ratio_ = 0;
   std::vector<ThreadScratch> scratch_;
   std::vector<double> partial_;
-  std::vector<std::size_t> split_;  ///< pair-list ranges of the threads (balance_pairs)
+  std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
+  bool reduce_pending_ = false;
+  bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
+  std::vector<double> tier_partial_;
   std::vector<double> xr_;  ///< packed (x, y, z, radius) per particle, refreshed by every drift  ///< per-thread partial results of the integration passes
   std::unique_ptr<ThreadPool> pool_;
 };
