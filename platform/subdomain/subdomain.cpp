@@ -17,6 +17,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 namespace domel::platform {
 
@@ -254,8 +255,16 @@ void Subdomain::step() {
   // fork/join less than a separate reduction).
   const bool reduce = reduce_pending_;
   reduce_pending_ = false;
-  pool_->for_range(n, [&](std::size_t first, std::size_t last, int t) {
-    if (reduce) reduce_partials(first, last);
+  if (reduce) reduce_split(n);
+  pool_->run([&](int t) {
+    std::size_t first = 0, last = n;
+    if (reduce) {
+      first = pass2_split_[static_cast<std::size_t>(t)];
+      last = pass2_split_[static_cast<std::size_t>(t) + 1];
+      reduce_partials(first, last);
+    } else {
+      std::tie(first, last) = pool_->range(n, t);
+    }
     partial[static_cast<std::size_t>(t)] =
         kick_check(first, last, half, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
                    s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
@@ -353,6 +362,48 @@ void Subdomain::pair_forces(bool defer_reduce) {
   }
 }
 
+void Subdomain::reduce_split(std::size_t n) {
+  // Split [0, n) for the second half kick so that each thread has the same
+  // estimated cost: a particle costs 1, plus kReduceCost for each other
+  // thread whose force span covers it (the reduction's loads and adds).
+  // Equal particle counts would leave the whole reduction to the threads
+  // whose share overlaps the spans. Deterministic: from the spans only.
+  constexpr double kReduceCost = 1.5;
+  const int nt = threads();
+  std::vector<std::size_t> cuts = {0, n};
+  for (int t = 1; t < nt; ++t) {
+    cuts.push_back(std::min(scratch_[static_cast<std::size_t>(t)].lo, n));
+    cuts.push_back(std::min(scratch_[static_cast<std::size_t>(t)].hi, n));
+  }
+  std::sort(cuts.begin(), cuts.end());
+  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+  auto weight = [&](std::size_t k) {
+    double w = 1.0;
+    for (int t = 1; t < nt; ++t) {
+      const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+      if (k >= ts.lo && k < ts.hi) w += kReduceCost;
+    }
+    return w;
+  };
+  double total = 0.0;
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) total += static_cast<double>(cuts[c + 1] - cuts[c]) * weight(cuts[c]);
+  pass2_split_.assign(static_cast<std::size_t>(nt) + 1, n);
+  pass2_split_[0] = 0;
+  double acc = 0.0;
+  int q = 1;
+  for (std::size_t c = 0; c + 1 < cuts.size() && q < nt; ++c) {
+    const double w = weight(cuts[c]);
+    const double seg = static_cast<double>(cuts[c + 1] - cuts[c]) * w;
+    while (q < nt && acc + seg >= total * q / nt) {
+      const double need = total * q / nt - acc;
+      pass2_split_[static_cast<std::size_t>(q)] =
+          std::min(cuts[c + 1], cuts[c] + static_cast<std::size_t>(std::ceil(need / w)));
+      ++q;
+    }
+    acc += seg;
+  }
+}
+
 void Subdomain::reduce_partials(std::size_t first, std::size_t last) {
   ParticleStore& s = store_;
   for (int t = 1; t < threads(); ++t) {
@@ -396,7 +447,7 @@ void Subdomain::balance_pairs(int nt) {
   // run is bit-identical for a given thread count. Recomputed every
   // kBalanceEvery steps and after each list build.
   constexpr uint64_t kContactCost = 8;
-  constexpr std::uint64_t kBalanceEvery = 8;
+  constexpr std::uint64_t kBalanceEvery = 32;
   const std::size_t tiers[3] = {0, nlist_.near_size(), nlist_.size()};
   if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds() &&
       steps_ % kBalanceEvery != 0)

@@ -115,6 +115,7 @@ class Subdomain {
   void contact_forces(bool defer_reduce = false);
   void pair_forces(bool defer_reduce);
   void reduce_partials(std::size_t first, std::size_t last);
+  void reduce_split(std::size_t n);
   void balance_pairs(int nt);
   void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc);
   void wall_forces();
@@ -142,6 +143,7 @@ class Subdomain {
   std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
   bool reduce_pending_ = false;
+  std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::vector<double> tier_partial_;
   std::vector<double> xr_;  ///< packed (x, y, z, radius) per particle, refreshed by every drift  ///< per-thread partial results of the integration passes
