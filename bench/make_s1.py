@@ -24,6 +24,7 @@ Usage:
 
 import argparse
 import json
+import math
 import os
 import sys
 
@@ -58,7 +59,16 @@ def label(n_requested):
     return str(n_requested)
 
 
-def scenario(n_requested):
+# S2 (the peers' settle.in with RF = cdt | epsd2, mu_r = 0.1): domel's like-for-like rolling models (issue 5):
+# dct with mu_r = 0.1 against LIGGGHTS cdt, sd_critical_angle with theta_c = atan(0.1) against LIGGGHTS epsd2.
+ROLLING = {
+    "none": {"model": "none"},
+    "cdt": {"model": "dct", "rolling_friction": 0.1},
+    "epsd2": {"model": "sd_critical_angle", "critical_angle": math.degrees(math.atan(0.1))},
+}
+
+
+def scenario(n_requested, rolling="none"):
     nx, ny, nz = lattice_dims(n_requested)
     a = SPACING * D
     # rounded to 1e-12 m (far below the 1e-9 a slack of the site count) only to keep the JSON readable
@@ -66,7 +76,8 @@ def scenario(n_requested):
     n_actual = nx * ny * nz
     return {
         "$schema": "../../docs/domel.schema.json",
-        "name": "s1_settle_%s" % label(n_requested),
+        "name": ("s1_settle_%s" % label(n_requested)) if rolling == "none" else
+                ("s2_settle_%s_%s" % (label(n_requested), ROLLING[rolling]["model"])),
         "description": (
             "Peer benchmark S1 'settle' (../shared/peers/RESULTS.md), N requested %d -> %dx%dx%d = %d spheres "
             "(d = 2.8 mm, rho = 2500, E = 5e6 Pa, nu = 0.3, e = 0.5, mu = 0.5; Hertz + restitution damping + "
@@ -92,7 +103,7 @@ def scenario(n_requested):
                     "normal": {"model": "hertz"},
                     "damping": {"model": "restitution"},
                     "tangential": {"model": "mindlin"},
-                    "rolling": {"model": "none"},
+                    "rolling": dict(ROLLING[rolling]),
                 },
                 "time_step": DT,
                 "skin": SKIN,

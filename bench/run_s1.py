@@ -59,7 +59,7 @@ CSV_FIELDS = [
     "timestamp", "code", "N_requested", "N_actual", "rep", "ok", "timed_steps", "timed_wall_s",
     "particle_steps_per_s", "process_wall_s", "process_cpu_s", "timed_cpu_s", "particle_steps_per_cpu_s",
     "load1_start", "load1_end", "mean_contacts_per_particle", "ke_translational_final_J", "neighbor_builds_total",
-    "error", "log",
+    "peak_rss_bytes", "error", "log",
 ]
 
 
@@ -160,23 +160,23 @@ def cpu_in_last(samples, window_s):
     return None
 
 
-def scenario_file(n, workdir):
+def scenario_file(n, workdir, rolling="none"):
     """The committed bench/scenarios file for N when it exists and matches make_s1.py, else a fresh one."""
-    committed = os.path.join(HERE, "scenarios", "s1_settle_%s.json" % make_s1.label(n))
-    fresh = make_s1.scenario(n)
+    fresh = make_s1.scenario(n, rolling)
+    committed = os.path.join(HERE, "scenarios", fresh["name"] + ".json")
     if os.path.isfile(committed):
         with open(committed) as f:
             if json.load(f) == fresh:
                 return committed
         print("warning: %s differs from make_s1.py's output; using a regenerated copy" % committed,
               file=sys.stderr)
-    path = os.path.join(workdir, "s1_settle_%s.json" % make_s1.label(n))
+    path = os.path.join(workdir, fresh["name"] + ".json")
     with open(path, "w") as f:
         f.write(make_s1.dumps(fresh) + "\n")
     return path
 
 
-def run_domel(domel, n, rep, workdir, timeout, env, threads=1):
+def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
     nx, ny, nz = make_s1.lattice_dims(n)
     expected = nx * ny * nz
     code = "domel" if threads == 1 else "domel_%dt" % threads
@@ -184,7 +184,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1):
     log = outdir + ".screen"
     row = {"code": code, "N_requested": n, "rep": rep, "log": log}
     row["load1_start"] = load1()
-    rc, wall, cpu, samples = run_timed([domel, "run", scenario_file(n, workdir), "--out", outdir, "--quiet",
+    rc, wall, cpu, samples = run_timed([domel, "run", scenario_file(n, workdir, rolling), "--out", outdir, "--quiet",
                                "--time-after", str(NSETTLE), "--threads", str(threads)], workdir, log, timeout, env)
     row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)
     summary_path = os.path.join(outdir, "summary.json")
@@ -198,7 +198,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1):
         row.update(ok=0, error="summary.json has no timed_window")
         return row
     row.update(N_actual=s.get("particles"), timed_steps=tw.get("steps"), timed_wall_s=tw.get("wall_time_s"),
-               particle_steps_per_s=tw.get("particle_steps_per_s"))
+               particle_steps_per_s=tw.get("particle_steps_per_s"), peak_rss_bytes=s.get("peak_rss_bytes"))
     sds = s.get("subdomains") or []
     if sds:
         sd = sds[0]
@@ -253,12 +253,12 @@ def parse_liggghts(text):
     return res
 
 
-def run_liggghts(liggghts, deckdir, n, rep, workdir, timeout, env):
+def run_liggghts(liggghts, deckdir, n, rep, workdir, timeout, env, rolling="none"):
     tag = "liggghts_N%d_r%d" % (n, rep)
     log, screen = os.path.join(workdir, tag + ".log"), os.path.join(workdir, tag + ".screen")
     row = {"code": "liggghts", "N_requested": n, "rep": rep, "log": screen}
     cmd = [liggghts, "-in", "settle.in", "-var", "N", str(n), "-var", "nsettle", str(NSETTLE),
-           "-var", "nrun", str(NRUN), "-var", "RF", "none", "-log", log]
+           "-var", "nrun", str(NRUN), "-var", "RF", rolling, "-log", log]
     if shutil.which("stdbuf"):  # LIGGGHTS dies silently when stdout is a file (RESULTS.md, problem 2)
         cmd = ["stdbuf", "-oL"] + cmd
     row["load1_start"] = load1()
@@ -290,7 +290,7 @@ def fmt_rate(st):
     return "%.2e [%.2e-%.2e]" % st
 
 
-def print_tables(rows, sizes, have_peer):
+def print_tables(rows, sizes, have_peer, deck="S1 settle"):
     print()
     head = ["N", "domel median [min-max]", "LIGGGHTS median [min-max]", "ratio domel/LIGGGHTS", "load"]
     lines = []
@@ -306,7 +306,7 @@ def print_tables(rows, sizes, have_peer):
         np_ = sum(1 for r in mine if r["code"] == "liggghts" and r.get("ok"))
         lines.append([str(nact), fmt_rate(d) + " (%d)" % nd,
                       (fmt_rate(p) + " (%d)" % np_) if have_peer else "not run", ratio, load])
-    print("S1 settle, timed particle-steps/s (2000 steps after 2000 untimed); (runs); "
+    print(deck + ", timed particle-steps/s (2000 steps after 2000 untimed); (runs); "
           "load = 1-min load average at the start of the runs")
     print_md(head, lines)
 
@@ -326,6 +326,24 @@ def print_tables(rows, sizes, have_peer):
                 tl.append([code, str(nact), fmt_rate(dt_), "%.2f" % (dt_[0] / d1[0]) if dt_ and d1 else "-",
                            "%.2f" % (dt_[0] / p[0]) if dt_ and p else "-"])
         print_md(["domel", "N", "median [min-max]", "speed-up", "ratio domel/LIGGGHTS serial"], tl)
+
+    mem = []
+    for n in sizes:
+        mine = [r for r in rows if r["N_requested"] == n and r["code"] == "domel" and r.get("ok")]
+        rss = stats([r.get("peak_rss_bytes") for r in mine])
+        nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), None)
+        if rss and nact:
+            mem.append((float(nact), rss[0]))
+    if mem:
+        print()
+        print("domel peak resident memory (1 thread, median over runs; whole process: libraries, VTK, the pair list and "
+              "its contact history included); bytes per particle = slope between the sizes")
+        ml = [[str(int(nn)), "%.1f MB" % (r / 1e6), "%.0f" % (r / nn)] for nn, r in mem]
+        print_md(["N", "peak RSS", "RSS / N (bytes)"], ml)
+        if len(mem) >= 2:
+            (n1, r1), (n2, r2) = mem[0], mem[-1]
+            if n2 != n1:
+                print("marginal memory per particle between N = %d and %d: %.0f bytes" % (n1, n2, (r2 - r1) / (n2 - n1)))
 
     print()
     print("Per CPU-second of the timed steps (robust to time-slicing on a loaded machine): LIGGGHTS from the "
@@ -402,8 +420,13 @@ def report(csv_path):
     for r in rows:
         if r["N_requested"] not in sizes:
             sizes.append(r["N_requested"])
-    print("S1 settle results from %s" % csv_path)
-    print_tables(rows, sizes, any(r["code"] == "liggghts" for r in rows))
+    print("Results from %s" % csv_path)
+    base = os.path.basename(csv_path)
+    deck = "S1 settle"
+    for rf in make_s1.ROLLING:
+        if base.startswith("s2_%s_" % rf):
+            deck = "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (rf, make_s1.ROLLING[rf]["model"])
+    print_tables(rows, sizes, any(r["code"] == "liggghts" for r in rows), deck)
     return 0 if all(r.get("ok") for r in rows) else 1
 
 
@@ -420,6 +443,9 @@ def main(argv=None):
     ap.add_argument("--peers", default=default_peers(), help="peers folder with liggghts/settle.in and cpusec.sh")
     ap.add_argument("--timeout", type=float, default=900, help="per-run timeout in s (default 900)")
     ap.add_argument("--results", default=os.path.join(HERE, "results"), help="CSV folder (default bench/results)")
+    ap.add_argument("--rolling", choices=sorted(make_s1.ROLLING), default="none",
+                    help="S1 (none, default) or S2: LIGGGHTS RF = cdt against domel dct (mu_r = 0.1), RF = epsd2 "
+                         "against domel sd_critical_angle (theta_c = atan 0.1)")
     ap.add_argument("--threads", type=int, nargs="+", default=[1],
                     help="domel thread counts to run (default 1; e.g. --threads 1 2); LIGGGHTS always runs serially")
     ap.add_argument("--report", metavar="CSV", help="only print the tables of an earlier run's CSV, run nothing")
@@ -464,7 +490,9 @@ def main(argv=None):
         deckdir = os.path.join(peer_copy, "liggghts")
 
     info = machine_info()
-    print("S1 settle benchmark %s on %s: %s cores, %s; load average %s" % (
+    deck = "S1 settle" if args.rolling == "none" else "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (
+        args.rolling, make_s1.ROLLING[args.rolling]["model"])
+    print("%s benchmark %s on %s: %s cores, %s; load average %s" % (deck,
         stamp, info["host"], info["nproc"], info["cpu"], " ".join("%.2f" % x for x in os.getloadavg())))
     print("domel: %s" % args.domel)
     print("LIGGGHTS: %s" % (("%s, deck %s (copied to %s)" % (args.liggghts, os.path.join(args.peers, "liggghts"),
@@ -473,18 +501,20 @@ def main(argv=None):
     print()
 
     os.makedirs(args.results, exist_ok=True)
-    csv_path = os.path.join(args.results, "s1_%s.csv" % stamp)
+    csv_path = os.path.join(args.results, ("s1_%s.csv" % stamp) if args.rolling == "none" else
+                            ("s2_%s_%s.csv" % (args.rolling, stamp)))
     rows = []
     with open(csv_path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=CSV_FIELDS)
         w.writeheader()
         for n in sizes:
             for rep in range(1, reps + 1):
-                jobs = [("domel", lambda t=t: run_domel(args.domel, n, rep, workdir, args.timeout, env, t))
+                jobs = [("domel", lambda t=t: run_domel(args.domel, n, rep, workdir, args.timeout, env, t,
+                                                        args.rolling))
                         for t in args.threads]
                 if have_peer:
                     jobs.append(("liggghts", lambda: run_liggghts(args.liggghts, deckdir, n, rep, workdir,
-                                                                  args.timeout, env)))
+                                                                  args.timeout, env, args.rolling)))
                 for _, job in jobs:
                     row = job()
                     row["timestamp"] = time.strftime("%Y-%m-%dT%H:%M:%S")
@@ -507,7 +537,7 @@ def main(argv=None):
                         print("%-8s N=%-6s rep %d: FAILED: %s" % (row["code"], n, rep, row.get("error")),
                               flush=True)
 
-    print_tables(rows, sizes, have_peer)
+    print_tables(rows, sizes, have_peer, deck)
     print()
     print("CSV: %s" % csv_path)
     failed = [r for r in rows if not r.get("ok")]

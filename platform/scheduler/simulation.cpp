@@ -2,6 +2,8 @@
 // The run loop: multi-rate stepping of subdomains, outputs and progress.
 #include "scheduler/simulation.hpp"
 
+#include <sys/resource.h>
+
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv_series.hpp"
@@ -169,6 +171,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   summary["wall_time_s"] = wall;
   summary["particles"] = particles;
   summary["particle_steps_per_s"] = result.particle_steps_per_second;
+  {
+    // Peak resident memory of the process (getrusage; Linux reports KiB). The
+    // benchmark turns two sizes into bytes per particle (docs/performance.md).
+    struct rusage usage {};
+    if (getrusage(RUSAGE_SELF, &usage) == 0) summary["peak_rss_bytes"] = static_cast<long long>(usage.ru_maxrss) * 1024;
+  }
   nlohmann::json libs = nlohmann::json::array();
   for (const auto& lib : registry.libraries())
     libs.push_back({{"name", lib.name}, {"version", lib.version}, {"path", lib.path.string()},
