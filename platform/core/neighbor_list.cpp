@@ -29,17 +29,30 @@ bool NeighborList::needs_rebuild(const ParticleStore& s) const {
 
 void NeighborList::build(const ParticleStore& s) {
   const std::size_t n = s.size();
-  // Remember live history by (id_i, id_j).
+  // Keep only the live history (pairs in contact, ~1-2 per particle), keyed by
+  // (id_i, id_j), and release the old list before the new one is built: the
+  // build's peak memory is then the new list plus the contacts, not two lists
+  // (docs/performance.md, memory).
+  std::size_t live = 0;
+  for (std::size_t k = 0; k < i.size(); ++k) live += touching[k] ? 1 : 0;
   std::unordered_map<std::uint64_t, std::size_t> old;
-  old.reserve(i.size());
-  for (std::size_t k = 0; k < i.size(); ++k)
-    if (touching[k]) old.emplace(pair_key(built_ids_[i[k]], built_ids_[j[k]]), k);
+  old.reserve(live);
   std::vector<double> old_history;
-  old_history.swap(history);
-  std::vector<uint32_t> old_i, old_j;
-  old_i.swap(i);
-  old_j.swap(j);
-  touching.clear();
+  old_history.reserve(live * stride_);
+  for (std::size_t k = 0; k < i.size(); ++k) {
+    if (!touching[k]) continue;
+    old.emplace(pair_key(built_ids_[i[k]], built_ids_[j[k]]), old_history.size() / std::max<uint32_t>(stride_, 1));
+    old_history.insert(old_history.end(), history.begin() + static_cast<std::ptrdiff_t>(k * stride_),
+                       history.begin() + static_cast<std::ptrdiff_t>((k + 1) * stride_));
+  }
+  const std::size_t previous = i.size();
+  for (auto* v : {&i, &j}) std::vector<uint32_t>().swap(*v);
+  std::vector<double>().swap(history);
+  std::vector<uint8_t>().swap(touching);
+  // Tiers (see near_size()): near entries go to i/j, far ones to fi/fj, each in
+  // build order; far is appended after the cell loop.
+  const double h = near_gap();
+  std::vector<uint32_t> fi, fj;
 
   if (n > 0) {
     double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -83,8 +96,10 @@ void NeighborList::build(const ParticleStore& s) {
       std::vector<uint32_t> fill(start.begin(), start.end() - 1);
       for (std::size_t k = 0; k < n; ++k) order[fill[cell_index[k]]++] = static_cast<uint32_t>(k);
     }
-    i.reserve(old_i.size() + n);
-    j.reserve(old_j.size() + n);
+    // size from the last build (+5 %) rather than growing by doubling
+    const std::size_t expect = previous > 0 ? previous + previous / 20 : 4 * n;
+    i.reserve(expect);
+    j.reserve(expect);
     for (std::size_t a = 0; a < n; ++a) {
       int c[3];
       cell_of(a, c);
@@ -104,9 +119,13 @@ void NeighborList::build(const ParticleStore& s) {
               if ((s.flags[a] & s.flags[b] & ParticleStore::kFixed) != 0) continue;  // two fixed: never interact
               const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
               const double cut = s.radius[a] + s.radius[b] + skin_;
-              if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) {
-                if (s.id[a] < s.id[b]) { i.push_back(static_cast<uint32_t>(a)); j.push_back(b); }
-                else { i.push_back(b); j.push_back(static_cast<uint32_t>(a)); }
+              const double d2 = ddx * ddx + ddy * ddy + ddz * ddz;
+              if (d2 < cut * cut) {
+                const bool near = std::sqrt(d2) - s.radius[a] - s.radius[b] < h;
+                auto& ti = near ? i : fi;
+                auto& tj = near ? j : fj;
+                if (s.id[a] < s.id[b]) { ti.push_back(static_cast<uint32_t>(a)); tj.push_back(b); }
+                else { ti.push_back(b); tj.push_back(static_cast<uint32_t>(a)); }
               }
             }
           }
@@ -114,34 +133,19 @@ void NeighborList::build(const ParticleStore& s) {
       }
     }
   }
-  // Tiers: near entries first, far after, each in build order (stable).
-  {
-    const double h = near_gap();
-    std::vector<uint32_t> ti, tj;
-    ti.reserve(i.size());
-    tj.reserve(j.size());
-    for (int pass = 0; pass < 2; ++pass) {
-      for (std::size_t k = 0; k < i.size(); ++k) {
-        const uint32_t a = i[k], b = j[k];
-        const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
-        const double gap = std::sqrt(ddx * ddx + ddy * ddy + ddz * ddz) - s.radius[a] - s.radius[b];
-        if ((gap < h) == (pass == 0)) {
-          ti.push_back(a);
-          tj.push_back(b);
-        }
-      }
-      if (pass == 0) near_size_ = ti.size();
-    }
-    i.swap(ti);
-    j.swap(tj);
-  }
+  near_size_ = i.size();
+  i.insert(i.end(), fi.begin(), fi.end());
+  j.insert(j.end(), fj.begin(), fj.end());
+  std::vector<uint32_t>().swap(fi);
+  std::vector<uint32_t>().swap(fj);
   history.assign(i.size() * stride_, 0.0);
   touching.assign(i.size(), 0);
   if (!old.empty() && stride_ > 0) {
     for (std::size_t k = 0; k < i.size(); ++k) {
       auto it = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
       if (it == old.end()) continue;
-      std::copy_n(old_history.begin() + it->second * stride_, stride_, history.begin() + k * stride_);
+      std::copy_n(old_history.begin() + static_cast<std::ptrdiff_t>(it->second * stride_), stride_,
+                  history.begin() + static_cast<std::ptrdiff_t>(k * stride_));
       touching[k] = 1;
     }
   }
