@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <tuple>
@@ -259,9 +260,15 @@ void Subdomain::step() {
   pool_->run([&](int t) {
     std::size_t first = 0, last = n;
     if (reduce) {
+      // the other threads' pair forces, then the wall contacts of this
+      // thread's particles (each wall contact touches one particle)
       first = pass2_split_[static_cast<std::size_t>(t)];
       last = pass2_split_[static_cast<std::size_t>(t) + 1];
       reduce_partials(first, last);
+      ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+      ts.wall_contacts = 0;
+      ts.wall_max_ratio = 0.0;
+      wall_range(ts, first, last);
     } else {
       std::tie(first, last) = pool_->range(n, t);
     }
@@ -270,6 +277,13 @@ void Subdomain::step() {
                    s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
                    s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data());
   });
+  if (reduce) {
+    last_wall_contacts_ = 0;
+    for (const auto& ts : scratch_) {
+      last_wall_contacts_ += ts.wall_contacts;
+      last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.wall_max_ratio);
+    }
+  }
   const bool finite = std::none_of(partial.begin(), partial.end(), [](double p) { return p != 0.0; });
   time_ += dt;
   ++steps_;
@@ -300,7 +314,11 @@ void Subdomain::compute_forces() {
 void Subdomain::contact_forces(bool defer_reduce) {
   last_max_overlap_ratio_ = 0;
   pair_forces(defer_reduce);
-  wall_forces();
+  if (reduce_pending_) {
+    prune_removed_walls();  // the walls' forces follow in step()'s second pass, per particle range
+  } else {
+    wall_forces();
+  }
 }
 
 void Subdomain::pair_forces(bool defer_reduce) {
@@ -615,9 +633,27 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   ts.max_ratio = std::max(ts.max_ratio, max_ratio);
 }
 
+void Subdomain::prune_removed_walls() {
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w)
+    if (time_ >= (*walls_)[w].remove_at && !wall_lists_[w].particle.empty())  // removed: contacts open for good
+      wall_lists_[w] = WallNeighbors{};
+}
+
 void Subdomain::wall_forces() {
-  ParticleStore& s = store_;
+  prune_removed_walls();
   ThreadScratch& ts = scratch_[0];
+  ts.wall_contacts = 0;
+  ts.wall_max_ratio = 0.0;
+  wall_range(ts, 0, store_.size());
+  last_wall_contacts_ = ts.wall_contacts;
+  last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.wall_max_ratio);
+}
+
+void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t last) {
+  // Wall contacts of the particles with index in [first, last). Each touches
+  // one particle, so threads with disjoint particle ranges may run this at
+  // once (step() does, in its second pass). Wall lists are in index order.
+  ParticleStore& s = store_;
   auto& buf = ts.ws->buf;
   const uint32_t stride = pipeline_->history_stride();
   std::size_t contacts = 0;
@@ -625,10 +661,11 @@ void Subdomain::wall_forces() {
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     WallNeighbors& list = wall_lists_[w];
     const WallPrimitive& wall = (*walls_)[w];
-    if (time_ >= wall.remove_at) {  // removed: its contacts open for good
-      if (!list.particle.empty()) list = WallNeighbors{};
-      continue;
-    }
+    if (time_ >= wall.remove_at) continue;  // pruned by prune_removed_walls()
+    const auto lo = std::lower_bound(list.particle.begin(), list.particle.end(), static_cast<uint32_t>(first));
+    const auto hi = std::lower_bound(lo, list.particle.end(), static_cast<uint32_t>(std::min<std::size_t>(last, UINT32_MAX)));
+    const std::size_t e_first = static_cast<std::size_t>(lo - list.particle.begin());
+    const std::size_t e_last = static_cast<std::size_t>(hi - list.particle.begin());
     uint32_t c = 0;
     auto flush = [&]() {
       if (c == 0) return;
@@ -649,14 +686,14 @@ void Subdomain::wall_forces() {
       contacts += c;
       c = 0;
     };
-    for (std::size_t e = 0; e < list.particle.size(); ++e) {
+    for (std::size_t e = e_first; e < e_last; ++e) {
       const uint32_t i = list.particle[e];
       double d, nx, ny, nz;
       const bool has = wall.gap(s.x[i], s.y[i], s.z[i], d, nx, ny, nz);
       if (!has || d >= s.radius[i]) {
         if (list.touching[e]) {
           list.touching[e] = 0;
-          std::fill_n(list.history.begin() + e * stride, stride, 0.0);
+          std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(e * stride), stride, 0.0);
         }
         continue;
       }
@@ -684,8 +721,8 @@ void Subdomain::wall_forces() {
     }
     flush();
   }
-  last_wall_contacts_ = contacts;
-  last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, max_ratio);
+  ts.wall_contacts += contacts;
+  ts.wall_max_ratio = std::max(ts.wall_max_ratio, max_ratio);
 }
 
 SubdomainStats Subdomain::stats() const {

@@ -98,6 +98,8 @@ class Subdomain {
     std::vector<double> fx, fy, fz, tx, ty, tz;  ///< accumulators (threads > 0)
     std::vector<uint32_t> contacts;
     std::size_t n_contacts = 0;
+    std::size_t wall_contacts = 0;
+    double wall_max_ratio = 0;
     std::size_t lo = 0, hi = 0;      ///< particle-index span of this thread's pairs this step (threads > 0)
     std::size_t span[2][2] = {{0, 0}, {0, 0}};  ///< the span per list tier (near, far)
     double max_ratio = 0;
@@ -119,6 +121,8 @@ class Subdomain {
   void balance_pairs(int nt);
   void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc);
   void wall_forces();
+  void prune_removed_walls();
+  void wall_range(ThreadScratch& ts, std::size_t first, std::size_t last);
 
   std::string name_;
   double coarse_grain_;
