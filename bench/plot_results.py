@@ -70,8 +70,7 @@ def main(argv=None):
         med = [statistics.median(by_n[n]) for n in ns]
         lo = [m - min(by_n[n]) for m, n in zip(med, ns)]
         hi = [max(by_n[n]) - m for m, n in zip(med, ns)]
-        label = "%s %s" % (deck, {"liggghts": "LIGGGHTS (serial)"}.get(code, code.replace("domel_", "domel ")
-                                                                        .replace("domel", "domel", 1)))
+        label = "%s %s" % (deck, {"liggghts": "LIGGGHTS (serial)"}.get(code, code.replace("domel_", "domel ")))
         ax.errorbar(ns, med, yerr=[lo, hi], marker="o", capsize=3, label=label)
     ax.set_xscale("log")
     ax.set_xlabel("particles N")

@@ -49,6 +49,8 @@ commands:
 
 plugins are loaded from the built-in folder, then from each folder in
 $DOMEL_PLUGIN_PATH (':'-separated), then from the scenario's "plugins" list.
+$DOMEL_THREADS (1..256) sets the thread count where neither --threads nor the
+scenario's run.threads does.
 )";
 
 struct UsageError : std::runtime_error {
@@ -101,6 +103,16 @@ long parse_count(const std::string& option, const std::string& value) {
   }
 }
 
+/// DOMEL_THREADS, checked before anything is read or written so that a bad
+/// value is a usage error, not a failure half-way through building a run.
+void check_thread_environment() {
+  try {
+    (void)dp::default_thread_count();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 int parse_threads(const std::string& value) {
   const long n = parse_count("--threads", value);
   if (n > 256) throw UsageError("--threads expects at most 256, found " + value);
@@ -130,6 +142,7 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
 int cmd_run(int argc, char** argv) {
   const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps", "--time-after"}, {"--quiet", "--verbose"});
   if (a.positional.size() != 1) throw UsageError("run expects one scenario file");
+  check_thread_environment();
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
   if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
   dp::RunOptions opt;
@@ -163,6 +176,7 @@ int cmd_run(int argc, char** argv) {
 }
 
 int cmd_compare(int argc, char** argv) {
+  check_thread_environment();
   // --vary and --label repeat, so they are collected here rather than by parse()
   dp::CompareOptions opt;
   std::vector<std::string> varies, labels;

@@ -5,7 +5,10 @@
 #include "core/thread_pool.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 namespace domel::platform {
 
@@ -18,14 +21,26 @@ namespace {
 // ~3-6 us with 30-100 us of serial work between forks.
 constexpr int kBusy = 20000;
 constexpr int kSpin = 2000;
+
+/// Busy-spin, then yield, until done() holds or both budgets are spent;
+/// the caller then sleeps on its condition variable if still needed.
+template <class Done>
+void spin_until(Done&& done) {
+  for (int k = 0; k < kBusy && !done(); ++k) {
+  }
+  for (int k = 0; k < kSpin && !done(); ++k) std::this_thread::yield();
 }
+}  // namespace
 
 int default_thread_count() {
   const char* env = std::getenv("DOMEL_THREADS");
   if (env == nullptr || *env == '\0') return 1;
   char* end = nullptr;
+  errno = 0;
   const long n = std::strtol(env, &end, 10);
-  if (*end != '\0' || n < 1 || n > 256) return 1;
+  if (*end != '\0' || errno != 0 || n < 1 || n > 256)
+    throw std::invalid_argument(std::string("the environment variable DOMEL_THREADS expects an integer from 1 to 256, found '") +
+                                env + "'");
   return static_cast<int>(n);
 }
 
@@ -61,9 +76,7 @@ void ThreadPool::run(const std::function<void(int)>& fn) {
   } catch (...) {
     errors_[0] = std::current_exception();
   }
-  for (int k = 0; k < kBusy && pending_.load(std::memory_order_acquire) > 0; ++k) {
-  }
-  for (int k = 0; k < kSpin && pending_.load() > 0; ++k) std::this_thread::yield();
+  spin_until([this] { return pending_.load(std::memory_order_acquire) == 0; });
   if (pending_.load() > 0) {
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [this] { return pending_.load() == 0; });
@@ -75,9 +88,7 @@ void ThreadPool::run(const std::function<void(int)>& fn) {
 void ThreadPool::worker(int t) {
   std::uint64_t seen = 0;
   for (;;) {
-    for (int k = 0; k < kBusy && generation_.load(std::memory_order_acquire) == seen; ++k) {
-    }
-    for (int k = 0; k < kSpin && generation_.load() == seen; ++k) std::this_thread::yield();
+    spin_until([&] { return generation_.load(std::memory_order_acquire) != seen; });
     const std::function<void(int)>* job;
     {
       std::unique_lock<std::mutex> lock(mutex_);

@@ -25,6 +25,8 @@ namespace domel::platform {
 /// The thread count used where neither the command line (--threads) nor the
 /// scenario (run.threads) sets one: the environment variable DOMEL_THREADS
 /// (an integer 1..256), else 1. Lets a whole test suite run threaded.
+/// Throws std::invalid_argument naming the variable when it is set to
+/// anything else.
 int default_thread_count();
 
 class ThreadPool {

@@ -180,7 +180,7 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
                         const double* __restrict im, const double* __restrict ii, const double* __restrict m,
                         uint32_t* __restrict contacts, const double* __restrict x0, const double* __restrict y0,
                         const double* __restrict z0, double limit2, double limit2_far,
-                        double& far_tier, const double* __restrict r, double* __restrict xr) {
+                        double& far_tier) {
   const double g0 = g[0], g1 = g[1], g2 = g[2];
   double far = 0.0, tier = 0.0;
   for (std::size_t k = first; k < last; ++k) {
@@ -188,7 +188,6 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
     vx[k] += hm * fx[k]; vy[k] += hm * fy[k]; vz[k] += hm * fz[k];
     wx[k] += hi * tx[k]; wy[k] += hi * ty[k]; wz[k] += hi * tz[k];
     x[k] += dt * vx[k]; y[k] += dt * vy[k]; z[k] += dt * vz[k];
-    xr[4 * k] = x[k]; xr[4 * k + 1] = y[k]; xr[4 * k + 2] = z[k]; xr[4 * k + 3] = r[k];
     if constexpr (kCheck) {
       const double dx = x[k] - x0[k], dy = y[k] - y0[k], dz = z[k] - z0[k];
       const double d2 = dx * dx + dy * dy + dz * dz;
@@ -233,7 +232,6 @@ void Subdomain::step() {
   partial.assign(static_cast<std::size_t>(nt), 0.0);
   std::vector<double>& tier = tier_partial_;
   tier.assign(static_cast<std::size_t>(nt), 0.0);
-  xr_.resize(4 * n);
   // Pass 1 (one sweep over the store instead of the four of a textbook
   // step: kick-drift, rebuild check, force reset; docs/performance.md).
   const bool stale = nlist_.layout_stale(s);
@@ -244,7 +242,7 @@ void Subdomain::step() {
              s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
              s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data(), s.mass.data(), s.contacts.data(),
              nlist_.x0(), nlist_.y0(), nlist_.z0(), nlist_.rebuild_displacement2(),
-             nlist_.far_tier_displacement2(), tier[static_cast<std::size_t>(t)], s.radius.data(), xr_.data());
+             nlist_.far_tier_displacement2(), tier[static_cast<std::size_t>(t)]);
   });
   if (stale || std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) {
     rebuild_lists();
@@ -297,10 +295,8 @@ void Subdomain::step() {
 
 void Subdomain::compute_forces() {
   ParticleStore& s = store_;
-  xr_.resize(4 * s.size());
   pool_->for_range(s.size(), [&](std::size_t first, std::size_t last, int) {
     for (std::size_t k = first; k < last; ++k) {
-      xr_[4 * k] = s.x[k]; xr_[4 * k + 1] = s.y[k]; xr_[4 * k + 2] = s.z[k]; xr_[4 * k + 3] = s.radius[k];
       s.fx[k] = s.mass[k] * gravity_[0];
       s.fy[k] = s.mass[k] * gravity_[1];
       s.fz[k] = s.mass[k] * gravity_[2];
@@ -514,9 +510,8 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   const uint32_t* __restrict lj = nlist_.j.data();
   uint8_t* __restrict touching = nlist_.touching.data();
   double* __restrict list_history = nlist_.history.data();
-  // Positions and radii packed per particle (x, y, z, r): one cache line per
-  // partner instead of four in the screening loop below.
-  const double* __restrict xr = xr_.data();
+  const double* __restrict px = s.x.data(); const double* __restrict py = s.y.data();
+  const double* __restrict pz = s.z.data(); const double* __restrict pr = s.radius.data();
   const double* __restrict pvx = s.vx.data(); const double* __restrict pvy = s.vy.data();
   const double* __restrict pvz = s.vz.data();
   const double* __restrict pwx = s.wx.data(); const double* __restrict pwy = s.wy.data();
@@ -546,10 +541,9 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
     // branch here mispredicts often.
     uint32_t c = 0;
     for (; e < last && c < kBatch; ++e) {
-      const double* pi = xr + 4 * static_cast<std::size_t>(li[e]);
-      const double* pj = xr + 4 * static_cast<std::size_t>(lj[e]);
-      const double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
-      const double rsum = pi[3] + pj[3];
+      const uint32_t i = li[e], j = lj[e];
+      const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
+      const double rsum = pr[i] + pr[j];
       const uint32_t in = (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
       if (touching[e] > in) {  // the contact opened: its history ends
         touching[e] = 0;
@@ -563,10 +557,8 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
     for (uint32_t q = 0; q < c; ++q) {
       const uint32_t le = entry[q];
       const uint32_t i = li[le], j = lj[le];
-      const double* pi = xr + 4 * static_cast<std::size_t>(i);
-      const double* pj = xr + 4 * static_cast<std::size_t>(j);
-      const double ri = pi[3], rj = pj[3];
-      const double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
+      const double ri = pr[i], rj = pr[j];
+      const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
       const double rsum = ri + rj;
       const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
       const double inv = 1.0 / dist;

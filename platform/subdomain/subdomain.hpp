@@ -143,14 +143,12 @@ class Subdomain {
   std::size_t last_contacts_ = 0, last_wall_contacts_ = 0;
   double last_max_overlap_ratio_ = 0;
   std::vector<ThreadScratch> scratch_;
-  std::vector<double> partial_;
+  std::vector<double> partial_, tier_partial_;  ///< per-thread counts of the integration passes
   std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
   bool reduce_pending_ = false;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
-  std::vector<double> tier_partial_;
-  std::vector<double> xr_;  ///< packed (x, y, z, radius) per particle, refreshed by every drift  ///< per-thread partial results of the integration passes
   std::unique_ptr<ThreadPool> pool_;
 };
 

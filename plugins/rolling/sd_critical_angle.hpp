@@ -65,63 +65,42 @@ class SdCriticalAngle {
   }
 
   void compute(domel_contact_batch_v1& b) const {
-    // The batch arrays as local pointers and the branches as selects (the
-    // results are bit-identical to the if/else form): GCC reloads pointers
-    // read through `b` on every iteration and keeps branchy loops scalar.
     const uint32_t s = b.history_stride;
-    const uint32_t n = b.n;
-    const double dt = b.dt;
-    const double tan_c = tan_c_;
-    const bool damp_at_yield = damping_at_yield_;
-    const double* __restrict r_eff = b.r_eff;
-    const double* __restrict kn_used = tangent_ ? b.kn_tangent : b.kn;
-    const double* __restrict eta_n = b.eta_n;
-    const double* __restrict fn_el = b.fn_elastic;
-    const double* __restrict nx = b.nx; const double* __restrict ny = b.ny; const double* __restrict nz = b.nz;
-    const double* __restrict wx = b.wx; const double* __restrict wy = b.wy; const double* __restrict wz = b.wz;
-    double* __restrict hist = b.history;
-    double* __restrict tqx = b.tqx; double* __restrict tqy = b.tqy; double* __restrict tqz = b.tqz;
-    double* __restrict k_out = b.rolling_stiffness;
-    double* __restrict eta_out = b.rolling_damping;
-    for (uint32_t c = 0; c < n; ++c) {
-      double* th = hist + static_cast<size_t>(c) * s;
-      const double a = r_eff[c] * tan_c;
-      const double k = 0.25 * kn_used[c] * a * a;
-      const double eta = 0.25 * eta_n[c] * a * a;
-      const double m_ref = a * (fn_el[c] > 0.0 ? fn_el[c] : 0.0);  // cap from the non-negative elastic force
-      // relative rolling velocity: the tangential part of w_i - w_j
-      const double ux = nx[c], uy = ny[c], uz = nz[c];
-      const double wn = wx[c] * ux + wy[c] * uy + wz[c] * uz;
-      const double vx = wx[c] - wn * ux, vy = wy[c] - wn * uy, vz = wz[c] - wn * uz;
-      // history projected onto the current tangent plane, its length kept
-      const double h0 = th[0], h1 = th[1], h2 = th[2];
-      const double len0 = std::sqrt(h0 * h0 + h1 * h1 + h2 * h2);
-      const double proj = h0 * ux + h1 * uy + h2 * uz;
-      const double p0 = h0 - proj * ux, p1 = h1 - proj * uy, p2 = h2 - proj * uz;
-      const double len1 = std::sqrt(p0 * p0 + p1 * p1 + p2 * p2);
-      const bool rescale = len1 > 0.0;
-      const double keep = len0 / (rescale ? len1 : 1.0);
-      const double t0 = (rescale ? p0 * keep : p0) + vx * dt;
-      const double t1 = (rescale ? p1 * keep : p1) + vy * dt;
-      const double t2 = (rescale ? p2 * keep : p2) + vz * dt;
-      const double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
+    for (uint32_t c = 0; c < b.n; ++c) {
+      double* th = b.history + static_cast<size_t>(c) * s;
+      const double a = b.r_eff[c] * tan_c_;
+      const double kn = tangent_ ? b.kn_tangent[c] : b.kn[c];
+      const double k = 0.25 * kn * a * a;
+      const double eta = 0.25 * b.eta_n[c] * a * a;
+      const double m_ref = a * cap_force(b, c);
+      const Vec3 w = rolling_velocity(b, c);
+      // rotate the stored angle into the current tangent plane, keeping its length
+      const double len0 = std::sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+      const double proj = th[0] * b.nx[c] + th[1] * b.ny[c] + th[2] * b.nz[c];
+      double t0 = th[0] - proj * b.nx[c], t1 = th[1] - proj * b.ny[c], t2 = th[2] - proj * b.nz[c];
+      const double len1 = std::sqrt(t0 * t0 + t1 * t1 + t2 * t2);
+      if (len1 > 0.0) {
+        const double keep = len0 / len1;
+        t0 *= keep; t1 *= keep; t2 *= keep;
+      }
+      t0 += w.x * b.dt; t1 += w.y * b.dt; t2 += w.z * b.dt;
+      double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
       const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
-      const bool yielded = ms > m_ref;  // then ms > 0
-      const double scale = m_ref / (yielded ? ms : 1.0);
-      const double y0 = m0 * scale, y1 = m1 * scale, y2 = m2 * scale;
-      const bool has_k = k > 0.0;
-      const double kd = has_k ? k : 1.0;
-      const double e0 = has_k ? -y0 / kd : 0.0, e1 = has_k ? -y1 / kd : 0.0, e2 = has_k ? -y2 / kd : 0.0;
-      th[0] = yielded ? e0 : t0;  // plastic rescale: k|theta| = M_ref
-      th[1] = yielded ? e1 : t1;
-      th[2] = yielded ? e2 : t2;
-      const bool damp = !yielded || damp_at_yield;
-      const double d = damp ? eta : 0.0;
-      tqx[c] += (yielded ? y0 : m0) - d * vx;
-      tqy[c] += (yielded ? y1 : m1) - d * vy;
-      tqz[c] += (yielded ? y2 : m2) - d * vz;
-      k_out[c] = k;
-      eta_out[c] = eta;
+      bool yielded = false;
+      if (ms > m_ref) {
+        const double scale = ms > 0.0 ? m_ref / ms : 0.0;
+        m0 *= scale; m1 *= scale; m2 *= scale;
+        if (k > 0.0) { t0 = -m0 / k; t1 = -m1 / k; t2 = -m2 / k; }
+        else { t0 = t1 = t2 = 0.0; }
+        yielded = true;
+      }
+      if (!yielded || damping_at_yield_) {
+        m0 -= eta * w.x; m1 -= eta * w.y; m2 -= eta * w.z;
+      }
+      th[0] = t0; th[1] = t1; th[2] = t2;
+      b.tqx[c] += m0; b.tqy[c] += m1; b.tqz[c] += m2;
+      b.rolling_stiffness[c] = k;
+      b.rolling_damping[c] = eta;
     }
   }
 

@@ -69,9 +69,10 @@ class Cli : public ::testing::Test {
   }
 
   /// Runs domel with the arguments; stdout/stderr are captured to files in tmp_.
-  Result domel(const std::vector<std::string>& args) {
+  /// env: optional "NAME=value" set for this call only.
+  Result domel(const std::vector<std::string>& args, const std::string& env = "") {
     const fs::path out = tmp_ / "stdout.txt", err = tmp_ / "stderr.txt";
-    std::string cmd = shell_quote(kDomel);
+    std::string cmd = (env.empty() ? std::string() : "env " + shell_quote(env) + " ") + shell_quote(kDomel);
     for (const auto& a : args) cmd += " " + shell_quote(a);
     cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string()) + " </dev/null";
     const int status = std::system(cmd.c_str());
@@ -265,6 +266,22 @@ TEST_F(Cli, UnknownOptionIsAUsageError) {
   EXPECT_NE(r.err.find("unknown option --max-step"), std::string::npos) << show(r);
   EXPECT_NE(r.err.find("did you mean '--max-steps'?"), std::string::npos) << show(r);
   EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, BadThreadEnvironmentIsAUsageErrorAndWritesNothing) {
+  const fs::path out = tmp_ / "t";
+  for (const std::string bad : {"abc", "0", "300", "2x"}) {
+    const Result r = domel({"run", kSettle.string(), "--out", out.string(), "--max-steps", "5"}, "DOMEL_THREADS=" + bad);
+    EXPECT_EQ(r.exit_code, 64) << show(r);
+    EXPECT_NE(r.err.find("DOMEL_THREADS expects an integer from 1 to 256, found '" + bad + "'"), std::string::npos)
+        << show(r);
+    EXPECT_FALSE(fs::exists(out)) << bad;
+  }
+  const Result ok = domel({"run", kSettle.string(), "--out", out.string(), "--max-steps", "5", "--quiet"},
+                          "DOMEL_THREADS=2");
+  EXPECT_EQ(ok.exit_code, 0) << show(ok);
+  const json summary = json::parse(read_file(out / "summary.json"));
+  EXPECT_EQ(summary["threads"], 2);  // the environment sets the default when the scenario and CLI do not
 }
 
 TEST_F(Cli, NoCommandPrintsUsage) {
