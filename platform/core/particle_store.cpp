@@ -30,6 +30,21 @@ void ParticleStore::swap_remove(std::size_t k) {
   ++layout_version;
 }
 
+std::size_t ParticleStore::remove_marked(const std::vector<std::uint8_t>& remove) {
+  const std::size_t n = size();
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < n; ++k) kept += remove[k] ? 0 : 1;
+  if (kept == n) return 0;
+  for_each_array([&remove, n](auto& v) {
+    std::size_t w = 0;
+    for (std::size_t k = 0; k < n; ++k)
+      if (!remove[k]) v[w++] = v[k];
+    v.resize(w);
+  });
+  ++layout_version;
+  return n - kept;
+}
+
 void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
   for_each_array([&order](auto& v) {
     auto tmp = v;

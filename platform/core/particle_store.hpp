@@ -43,6 +43,11 @@ struct ParticleStore {
   /// Remove particle k by moving the last one into its place.
   void swap_remove(std::size_t k);
 
+  /// Remove every particle k with remove[k] != 0, keeping the others in
+  /// their order (a stable compaction: the spatial order of the store, and so
+  /// its cache locality, survives). Returns the number removed.
+  std::size_t remove_marked(const std::vector<std::uint8_t>& remove);
+
   /// Apply a permutation: new index k holds old particle order[k].
   void permute(const std::vector<std::uint32_t>& order);
 

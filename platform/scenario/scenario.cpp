@@ -2,6 +2,7 @@
 // Scenario validation passes and the construction of a Simulation.
 #include "scenario/scenario.hpp"
 
+#include "geometry/region.hpp"
 #include "scenario/json_schema.hpp"
 
 #include <spdlog/spdlog.h>
@@ -191,6 +192,10 @@ void check_models(Checker& ck, const json& doc, const PluginRegistry& registry) 
     if (const json* ins = member(sd, "insert"); ins && ins->is_array())
       for (std::size_t q = 0; q < ins->size(); ++q)
         check_model_block(ck, registry, (*ins)[q], idx(base + "/insert", q), DOMEL_KIND_INSERTION, false);
+    if (const json* pours = member(sd, "pour"); pours && pours->is_array())
+      for (std::size_t q = 0; q < pours->size(); ++q)
+        if (const json* ins = member((*pours)[q], "insert"))
+          check_model_block(ck, registry, *ins, idx(base + "/pour", q) + "/insert", DOMEL_KIND_INSERTION, false);
   }
 }
 
@@ -290,6 +295,43 @@ void check_references(Checker& ck, const json& doc) {
       }
     }
   }
+
+  // pours: a window that is not empty
+  if (const json* sds = member(doc, "subdomains"); sds && sds->is_array())
+    for (std::size_t k = 0; k < sds->size(); ++k)
+      if (const json* pours = member((*sds)[k], "pour"); pours && pours->is_array())
+        for (std::size_t q = 0; q < pours->size(); ++q) {
+          const json& p = (*pours)[q];
+          const json* a = member(p, "start");
+          const json* b = member(p, "end");
+          const double start = a && a->is_number() ? a->get<double>() : 0.0;
+          if (b && b->is_number() && b->get<double>() <= start)
+            ck.add(idx(idx("/subdomains", k) + "/pour", q) + "/end",
+                   "expected end > start, found end " + fmt_num(b->get<double>()) + " <= start " + fmt_num(start));
+        }
+
+  // deletion regions and mass-flow planes: unique names (they name probes.csv columns), sane windows and normals
+  std::set<std::string> flow_names;
+  auto check_flow_item = [&](const json& item, const std::string& pointer) {
+    if (!item.is_object()) return;
+    if (const json* n = member(item, "name"); n && n->is_string() && !flow_names.insert(n->get<std::string>()).second)
+      ck.add(pointer + "/name", "duplicate name '" + n->get<std::string>() + "'",
+             "deletion regions and mass-flow planes share one namespace (their probes.csv columns)");
+    if (const json* w = member(item, "rate_window"); w && w->is_array() && w->size() == 2 && (*w)[0].is_number() &&
+                                                      (*w)[1].is_number() && (*w)[1].get<double>() <= (*w)[0].get<double>())
+      ck.add(pointer + "/rate_window", "expected [t0, t1] with t1 > t0, found [" + fmt_num((*w)[0].get<double>()) +
+                                           ", " + fmt_num((*w)[1].get<double>()) + "]");
+    if (is_vec3(member(item, "normal"))) {
+      const json& n = item["normal"];
+      if (n[0].get<double>() == 0 && n[1].get<double>() == 0 && n[2].get<double>() == 0)
+        ck.add(pointer + "/normal", "expected a non-zero normal vector, found [0, 0, 0]");
+    }
+  };
+  if (const json* dr = member(doc, "deletion_regions"); dr && dr->is_array())
+    for (std::size_t k = 0; k < dr->size(); ++k) check_flow_item((*dr)[k], idx("/deletion_regions", k));
+  if (const json* out = member(doc, "output"); out && out->is_object())
+    if (const json* mf = member(*out, "mass_flow"); mf && mf->is_array())
+      for (std::size_t k = 0; k < mf->size(); ++k) check_flow_item((*mf)[k], idx("/output/mass_flow", k));
 
   // interactions
   std::set<std::pair<std::string, std::string>> pairs;
@@ -470,7 +512,9 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   }
   std::map<std::pair<std::string, std::string>, PairCoefficients> coeffs;
   for (const auto& it : doc["interactions"]) {
-    const auto key = std::minmax(it["materials"][0].get<std::string>(), it["materials"][1].get<std::string>());
+    // std::minmax returns references: bind the names first (temporaries would dangle)
+    const std::string a = it["materials"][0].get<std::string>(), b = it["materials"][1].get<std::string>();
+    const std::pair<std::string, std::string> key = std::minmax(a, b);
     coeffs[key] = {it["restitution"].get<double>(), it["friction"].get<double>()};
   }
   if (doc.contains("walls"))
@@ -571,24 +615,108 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
       }
     }
 
+    // pours: their model instances live for the run; one dry event per pour
+    // (no particle present) gives the radii it will insert, for the skin and
+    // the time step of a subdomain that starts empty.
+    std::vector<double> pour_radii;
+    if (sd.contains("pour")) {
+      for (std::size_t q = 0; q < sd["pour"].size(); ++q) {
+        const json& pb = sd["pour"][q];
+        const json& block = pb["insert"];
+        const std::string where = idx(base + "/pour", q);
+        const RegisteredModel* m = registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
+        try {
+          Pour p;
+          p.where = where;
+          p.subdomain = sim->subdomains.size();
+          p.model = std::make_shared<ModelInstance>(*m, plugin_params(block, DOMEL_KIND_INSERTION), "");
+          p.region = make_region(block["region"]);
+          if (block.contains("velocity"))
+            for (int a = 0; a < 3; ++a) p.velocity[a] = block["velocity"][a].get<double>();
+          p.fixed = block.value("fixed", false);
+          p.density = sim->materials[mat_index.at(mat_name)].density;
+          p.alpha = alpha;
+          p.mass_rate = pb["mass_rate"].get<double>();
+          if (pb.contains("total_mass")) p.total_mass = pb["total_mass"].get<double>();
+          p.start = pb.value("start", 0.0);
+          if (pb.contains("end")) p.end = pb["end"].get<double>();
+          std::uint64_t name_hash = 1469598103934665603ull;  // FNV-1a, as the start-up insertion
+          for (unsigned char ch : sd_name) name_hash = (name_hash ^ ch) * 1099511628211ull;
+          p.seed = block.contains("seed") ? block["seed"].get<std::uint64_t>()
+                                          : sim->seed * 1000003ull + name_hash + 7919ull * (q + 1);
+          if (pb.contains("interval")) {
+            p.interval = pb["interval"].get<double>();
+          } else {
+            // the time the inserted particles need to leave the region
+            const double speed = std::sqrt(p.velocity[0] * p.velocity[0] + p.velocity[1] * p.velocity[1] +
+                                           p.velocity[2] * p.velocity[2]);
+            const double g = std::sqrt(sim->gravity[0] * sim->gravity[0] + sim->gravity[1] * sim->gravity[1] +
+                                       sim->gravity[2] * sim->gravity[2]);
+            if (speed > 0) {
+              const double u[3] = {p.velocity[0] / speed, p.velocity[1] / speed, p.velocity[2] / speed};
+              p.interval = region_extent(p.region, u) / speed;
+            } else if (g > 0) {
+              const double u[3] = {sim->gravity[0] / g, sim->gravity[1] / g, sim->gravity[2] / g};
+              p.interval = std::sqrt(2.0 * region_extent(p.region, u) / g);
+            } else {
+              p.interval = 0.01;
+            }
+          }
+          domel_insert_request_v1 req{};
+          req.struct_size = sizeof(req);
+          req.region = p.region;
+          req.seed = p.seed;
+          req.length_scale = alpha;
+          std::vector<double> x, y, z, r;
+          p.model->insert(req, x, y, z, r);
+          if (x.empty()) {
+            ck.add(where + "/insert", "the insertion model placed no particle in the pour region",
+                   "enlarge the region or raise the model's volume_fraction / count");
+            continue;
+          }
+          pour_radii.insert(pour_radii.end(), r.begin(), r.end());
+          double one_event = 0;
+          for (double rr : r) one_event += p.density * 4.0 / 3.0 * M_PI * rr * rr * rr;
+          spdlog::info("subdomain '{}': pour {} inserts {:.4g} kg/s with '{}' every {:.4g} s (one full region: {} "
+                       "particles, {:.4g} kg)",
+                       sd_name, where, p.mass_rate, m->name, p.interval, x.size(), one_event);
+          if (one_event < p.mass_rate * p.interval)
+            spdlog::warn("{}: one filled pour region ({:.3g} kg) holds less than the mass of one interval ({:.3g} kg); "
+                         "the pour will fall behind its rate", where, one_event, p.mass_rate * p.interval);
+          sim->flow.pours.push_back(std::move(p));
+        } catch (const PluginError& e) {
+          ck.add(where + "/insert", e.what());
+        }
+      }
+    }
+
     if (ck.diags.size() > problems_before_insert) continue;  // no time step from a half-built subdomain
 
     // neighbour skin: fraction of the largest diameter
     double rmax = 0;
     for (double r : sub->store().radius) rmax = std::max(rmax, r);
+    for (double r : pour_radii) rmax = std::max(rmax, r);
     sub->set_skin(sd.value("skin", 0.5) * 2.0 * (rmax > 0 ? rmax : 1e-3));
 
     // time step
     const double v_imp = sd.value("impact_velocity", 1.0);
     TimeStepReport rep;
+    bool probe_particle = false;  // the smallest poured particle, present only for the estimate
+    if (!pour_radii.empty()) {
+      sub->store().add(0, 0.0, 0.0, 0.0, *std::min_element(pour_radii.begin(), pour_radii.end()),
+                       sim->materials[mat_index.at(mat_name)].density);
+      probe_particle = true;
+    }
     try {
       rep = sub->estimate_time_step(v_imp);
     } catch (const PluginError& e) {
       ck.add(base + "/contact", std::string("the contact model failed while estimating the time step: ") + e.what());
       continue;
     }
+    const bool was_empty = sub->store().size() == (probe_particle ? 1u : 0u);
+    if (probe_particle) sub->store().swap_remove(sub->store().size() - 1);
     const json ts = sd.value("time_step", json("auto"));
-    if (sub->store().size() == 0) {
+    if (was_empty && pour_radii.empty()) {
       if (!ts.is_number()) {
         ck.add(base + "/time_step", "cannot choose a time step automatically for a subdomain without particles",
                "give time_step in seconds");
@@ -597,6 +725,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
       rep.chosen = ts.get<double>();
       rep.reason = "given (no particles to check it against)";
     } else if (ts.is_number()) {
+      (void)was_empty;
       rep.chosen = ts.get<double>();
       rep.reason = "given";
       if (rep.chosen > rep.critical) {
@@ -626,6 +755,33 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     sim->time_steps.push_back(rep);
     sim->subdomains.push_back(std::move(sub));
   }
+  sim->flow.next_id = next_id;
+  for (int a = 0; a < 3; ++a) sim->flow.gravity[a] = sim->gravity[a];
+  sim->flow.deletion_interval = run.value("deletion_interval", 0.005);
+  if (doc.contains("deletion_regions"))
+    for (const auto& d : doc["deletion_regions"]) {
+      DeletionRegion dr;
+      dr.name = d["name"].get<std::string>();
+      dr.region = make_region(d["region"]);
+      if (d.contains("rate_window"))
+        for (int a = 0; a < 2; ++a) dr.rate_window[a] = d["rate_window"][a].get<double>();
+      sim->flow.deletions.push_back(dr);
+    }
+  if (doc.contains("output") && doc["output"].contains("mass_flow"))
+    for (const auto& d : doc["output"]["mass_flow"]) {
+      MassFlowPlane pl;
+      pl.name = d["name"].get<std::string>();
+      double len = 0;
+      for (int a = 0; a < 3; ++a) {
+        pl.p[a] = d["point"][a].get<double>();
+        pl.n[a] = d["normal"][a].get<double>();
+        len += pl.n[a] * pl.n[a];
+      }
+      for (int a = 0; a < 3; ++a) pl.n[a] /= std::sqrt(len);
+      if (d.contains("rate_window"))
+        for (int a = 0; a < 2; ++a) pl.rate_window[a] = d["rate_window"][a].get<double>();
+      sim->flow.planes.push_back(pl);
+    }
   if (!ck.diags.empty()) throw ConfigError(ck.diags);
 
   if (run.contains("duration")) {

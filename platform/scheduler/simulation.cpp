@@ -78,6 +78,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       columns.push_back(sd->name() + "." + c);
   if (repose_probe)
     for (const auto& sd : subdomains) columns.push_back(sd->name() + ".repose_angle_deg");
+  for (const auto& c : flow.columns()) columns.push_back(c);
+  flow.start(subdomains);
   std::unique_ptr<io::CsvSeries> probes;
   if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
   std::unique_ptr<io::VtkSeriesWriter> vtk;
@@ -94,6 +96,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (repose_probe)
       for (const auto& sd : subdomains)
         row.push_back(repose_angle(sd->store(), *repose_probe).value_or(std::nan("")));
+    flow.check_planes(subdomains);
+    flow.append_row(t, row);
     probes->append(row);
   };
   auto write_vtk = [&](double t) {
@@ -120,6 +124,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const std::uint64_t stop = options.max_steps ? std::min(options.max_steps, total_macro) : total_macro;
   for (;; ++m) {
     const double t = static_cast<double>(m) * macro;
+    if (!flow.empty() && m < stop) flow.update(t, subdomains);
     if (probes && t >= next_probe - 1e-9 * macro) {
       write_probes(t);
       next_probe += probe_interval;
@@ -132,7 +137,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
       for (int s = 0; s < substeps[k]; ++s) subdomains[k]->step();
-      const double ps = static_cast<double>(substeps[k]) * subdomains[k]->store().size();
+      const double ps = static_cast<double>(substeps[k]) * static_cast<double>(subdomains[k]->store().size());
       particle_steps += ps;
       if (options.time_after && m >= options.time_after) window_particle_steps += ps;
     }
@@ -169,7 +174,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   summary["steps"] = m;
   summary["simulated_time_s"] = result.simulated_time;
   summary["wall_time_s"] = wall;
-  summary["particles"] = particles;
+  {
+    std::size_t now = 0;
+    for (const auto& sd : subdomains) now += sd->store().size();
+    summary["particles"] = now;
+    summary["particles_at_start"] = particles;
+  }
   summary["particle_steps_per_s"] = result.particle_steps_per_second;
   {
     // Peak resident memory of the process (getrusage; Linux reports KiB). The
@@ -215,6 +225,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     summary["repose_angle_deg"] = angles;
   }
   summary["subdomains"] = sds;
+  if (!flow.empty()) {
+    flow.check_planes(subdomains);
+    const nlohmann::json flow_summary = flow.summary(subdomains);
+    for (auto& [key, value] : flow_summary.items()) summary[key] = value;
+  }
   if (options.time_after && m > options.time_after) {
     const double w = std::chrono::duration<double>(end - window_start).count();
     summary["timed_window"] = {{"from_step", options.time_after},

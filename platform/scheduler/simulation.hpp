@@ -8,6 +8,7 @@
 #include "core/material.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
+#include "scheduler/particle_flow.hpp"
 #include "subdomain/repose_probe.hpp"
 #include "subdomain/subdomain.hpp"
 
@@ -55,6 +56,7 @@ class Simulation {
   std::optional<ReposeProbeSettings> repose_probe;  ///< adds <subdomain>.repose_angle_deg to probes.csv
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
+  ParticleFlow flow;           ///< pours, deletion regions, mass-flow planes, mass balance
 
   /// Run to the end. Throws RuntimeError or PluginError on failure; every
   /// file written up to then is complete (written to a temporary name and renamed).

@@ -1,0 +1,252 @@
+// SPDX-License-Identifier: MIT
+// Pours, deletion regions, mass-flow planes and the exact mass balance
+// (particle_flow.hpp says why they run between steps and in batches).
+#include "scheduler/particle_flow.hpp"
+
+#include "core/error.hpp"
+#include "geometry/region.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace domel::platform {
+
+MassUnits mass_units(double kg) { return static_cast<MassUnits>(std::llround(kg * 1e18)); }
+
+double mass_kg(MassUnits u) {
+  // exact enough for printing: split into a high and a low part so that the
+  // conversion of a 128-bit sum does not lose the low digits of a small residual
+  const MassUnits unit = static_cast<MassUnits>(1000000000000000000LL);
+  const MassUnits whole = u / unit, frac = u % unit;
+  return static_cast<double>(whole) + static_cast<double>(frac) * 1e-18;
+}
+
+double FlowSeries::slope(double t0, double t1) const {
+  double st = 0, sv = 0, stt = 0, stv = 0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] < t0 - 1e-12 || t[k] > t1 + 1e-12) continue;
+    st += t[k]; sv += value[k]; stt += t[k] * t[k]; stv += t[k] * value[k];
+    ++n;
+  }
+  if (n < 3) return std::nan("");
+  const double den = n * stt - st * st;
+  return den > 0 ? (n * stv - st * sv) / den : std::nan("");
+}
+
+void ParticleFlow::start(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  accounts_.assign(subdomains.size(), MassAccount{});
+  for (std::size_t k = 0; k < subdomains.size(); ++k) {
+    const ParticleStore& s = subdomains[k]->store();
+    for (std::size_t p = 0; p < s.size(); ++p) accounts_[k].inserted += mass_units(s.mass[p]);
+    accounts_[k].n_inserted = s.size();
+  }
+  for (auto& pl : planes) pl.side.assign(subdomains.size(), {});
+  check_planes(subdomains);
+  next_check_ = deletion_interval;
+}
+
+void ParticleFlow::update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  if (!deletions.empty() && t >= next_check_ - 1e-12) {
+    check_planes(subdomains);  // count crossings before the crossed particles are deleted
+    delete_particles(subdomains);
+    while (next_check_ <= t + 1e-12) next_check_ += deletion_interval;
+  }
+  for (auto& p : pours) {
+    const double due = p.start + static_cast<double>(p.events) * p.interval;
+    if (t + 1e-12 < due || t >= p.end || p.inserted_mass >= p.total_mass) continue;
+    pour(p, t, *subdomains[p.subdomain]);
+  }
+}
+
+void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
+  // Cumulative target: each event inserts the mass of the interval it opens,
+  // so the mean rate is exact and a shortfall (a full region) is made up later.
+  const double elapsed = std::min(t, p.end) - p.start;
+  const double target = std::min(p.total_mass, p.mass_rate * (elapsed + p.interval));
+  ++p.events;
+  if (p.inserted_mass >= target) return;
+  ParticleStore& st = sd.store();
+  domel_insert_request_v1 req{};
+  req.struct_size = sizeof(req);
+  req.region = p.region;
+  req.seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
+  req.length_scale = p.alpha;
+  req.n_existing = st.size();
+  req.ex_x = st.x.data(); req.ex_y = st.y.data(); req.ex_z = st.z.data(); req.ex_r = st.radius.data();
+  std::vector<double> x, y, z, r;
+  try {
+    p.model->insert(req, x, y, z, r);
+  } catch (const PluginError& e) {
+    throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
+  }
+  // The candidates are independent random draws in random order, so taking
+  // them in order until the mass target is met keeps the size distribution.
+  std::size_t taken = 0;
+  for (std::size_t q = 0; q < x.size() && p.inserted_mass < target; ++q) {
+    const std::uint64_t id = next_id++;
+    st.add(id, x[q], y[q], z[q], r[q], p.density, p.fixed);
+    const std::size_t k = st.size() - 1;
+    st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
+    st.fx[k] = st.mass[k] * gravity[0]; st.fy[k] = st.mass[k] * gravity[1]; st.fz[k] = st.mass[k] * gravity[2];
+    p.inserted_mass += st.mass[k];
+    accounts_[p.subdomain].inserted += mass_units(st.mass[k]);
+    ++accounts_[p.subdomain].n_inserted;
+    ++taken;
+  }
+  p.inserted += taken;
+  const double deficit = target - p.inserted_mass;
+  if (deficit > 0 && p.mass_rate * p.interval > 0) {
+    p.shortfall = std::max(p.shortfall, deficit);
+    if (!p.warned && deficit > 0.5 * p.mass_rate * p.interval) {
+      p.warned = true;
+      spdlog::warn("{}: the pour region held only {} free places at t = {:.4g} s; {:.3g} kg behind the rate of "
+                   "{:.3g} kg/s (enlarge the region, raise the insertion's volume_fraction or shorten the interval)",
+                   p.where, x.size(), t, deficit, p.mass_rate);
+    }
+  }
+}
+
+void ParticleFlow::check_planes(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  for (auto& pl : planes) {
+    if (pl.side.size() != subdomains.size()) pl.side.assign(subdomains.size(), {});
+    for (std::size_t k = 0; k < subdomains.size(); ++k) {
+      const ParticleStore& s = subdomains[k]->store();
+      auto& side = pl.side[k];
+      for (std::size_t q = 0; q < s.size(); ++q) {
+        const double d = (s.x[q] - pl.p[0]) * pl.n[0] + (s.y[q] - pl.p[1]) * pl.n[1] + (s.z[q] - pl.p[2]) * pl.n[2];
+        const signed char now = d >= 0 ? 1 : -1;
+        auto [it, fresh] = side.try_emplace(s.id[q], now);
+        if (fresh || it->second == now) continue;
+        // crossed since the last check: along n (from - to +) counts positive
+        pl.mass += now > 0 ? s.mass[q] : -s.mass[q];
+        pl.count += now > 0 ? 1 : -1;
+        it->second = now;
+      }
+    }
+  }
+}
+
+void ParticleFlow::delete_particles(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  std::vector<std::uint8_t> mark;
+  for (std::size_t k = 0; k < subdomains.size(); ++k) {
+    ParticleStore& s = subdomains[k]->store();
+    mark.assign(s.size(), 0);
+    bool any = false;
+    for (std::size_t q = 0; q < s.size(); ++q) {
+      for (auto& d : deletions) {
+        if (!region_contains(d.region, s.x[q], s.y[q], s.z[q])) continue;
+        mark[q] = 1;
+        any = true;
+        ++d.removed;
+        d.removed_mass += s.mass[q];
+        accounts_[k].removed += mass_units(s.mass[q]);
+        ++accounts_[k].n_removed;
+        for (auto& pl : planes) pl.side[k].erase(s.id[q]);
+        break;  // a particle in two regions is counted by the first
+      }
+    }
+    if (any) s.remove_marked(mark);
+  }
+}
+
+std::vector<std::string> ParticleFlow::columns() const {
+  std::vector<std::string> c;
+  for (const auto& d : deletions) {
+    c.push_back(d.name + ".removed_kg");
+    c.push_back(d.name + ".rate_kg_s");
+  }
+  for (const auto& pl : planes) {
+    c.push_back(pl.name + ".mass_kg");
+    c.push_back(pl.name + ".rate_kg_s");
+  }
+  return c;
+}
+
+void ParticleFlow::append_row(double t, std::vector<double>& row) {
+  std::vector<double> now;
+  for (auto& d : deletions) {
+    d.series.t.push_back(t);
+    d.series.value.push_back(d.removed_mass);
+    now.push_back(d.removed_mass);
+  }
+  for (auto& pl : planes) {
+    pl.series.t.push_back(t);
+    pl.series.value.push_back(pl.mass);
+    now.push_back(pl.mass);
+  }
+  const bool first = std::isnan(last_row_t_) || t <= last_row_t_;
+  for (std::size_t k = 0; k < now.size(); ++k) {
+    row.push_back(now[k]);
+    row.push_back(first ? 0.0 : (now[k] - last_row_[k]) / (t - last_row_t_));
+  }
+  last_row_ = now;
+  last_row_t_ = t;
+}
+
+MassUnits ParticleFlow::residual(std::size_t k, const ParticleStore& s) const {
+  MassUnits present = 0;
+  for (std::size_t q = 0; q < s.size(); ++q) present += mass_units(s.mass[q]);
+  return accounts_.at(k).inserted - present - accounts_.at(k).removed;
+}
+
+nlohmann::json ParticleFlow::summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains) const {
+  nlohmann::json j = nlohmann::json::object();
+  nlohmann::json balance = nlohmann::json::object();
+  for (std::size_t k = 0; k < subdomains.size() && k < accounts_.size(); ++k) {
+    const ParticleStore& s = subdomains[k]->store();
+    MassUnits present = 0;
+    for (std::size_t q = 0; q < s.size(); ++q) present += mass_units(s.mass[q]);
+    const MassAccount& a = accounts_[k];
+    const MassUnits res = a.inserted - present - a.removed;
+    const long long res_units = static_cast<long long>(res);
+    balance[subdomains[k]->name()] = {{"inserted_kg", mass_kg(a.inserted)},
+                                      {"present_kg", mass_kg(present)},
+                                      {"removed_kg", mass_kg(a.removed)},
+                                      {"residual_kg", mass_kg(res)},
+                                      {"residual_units_1e-18kg", res_units},
+                                      {"exact", res == 0},
+                                      {"inserted", a.n_inserted},
+                                      {"present", s.size()},
+                                      {"removed", a.n_removed}};
+  }
+  j["mass_balance"] = balance;
+  if (!pours.empty()) {
+    nlohmann::json ps = nlohmann::json::array();
+    for (const auto& p : pours)
+      ps.push_back({{"block", p.where},
+                    {"subdomain", subdomains[p.subdomain]->name()},
+                    {"events", p.events},
+                    {"inserted", p.inserted},
+                    {"inserted_kg", p.inserted_mass},
+                    {"mass_rate_kg_s", p.mass_rate},
+                    {"largest_shortfall_kg", p.shortfall}});
+    j["pours"] = ps;
+  }
+  auto rate_json = [](const FlowSeries& s, const double w[2]) {
+    nlohmann::json r = nlohmann::json::object();
+    if (!std::isnan(w[0])) {
+      const double slope = s.slope(w[0], w[1]);
+      r = {{"window_s", {w[0], w[1]}}, {"rate_kg_s", std::isnan(slope) ? nlohmann::json(nullptr) : nlohmann::json(slope)}};
+    }
+    return r;
+  };
+  if (!deletions.empty()) {
+    nlohmann::json ds = nlohmann::json::object();
+    for (const auto& d : deletions)
+      ds[d.name] = {{"removed", d.removed}, {"removed_kg", d.removed_mass}, {"steady", rate_json(d.series, d.rate_window)}};
+    j["deletion_regions"] = ds;
+  }
+  if (!planes.empty()) {
+    nlohmann::json ps = nlohmann::json::object();
+    for (const auto& pl : planes)
+      ps[pl.name] = {{"net_count", pl.count}, {"net_kg", pl.mass}, {"steady", rate_json(pl.series, pl.rate_window)}};
+    j["mass_flow"] = ps;
+  }
+  return j;
+}
+
+}  // namespace domel::platform

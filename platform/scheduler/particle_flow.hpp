@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: MIT
+// Particles entering and leaving a run, and the mass balance that checks it:
+//   - pours: insertion during the run from a region at a mass rate (a silo
+//     fill), through the same insertion plugins as the start-up insertion;
+//   - deletion regions: particles whose centre enters the region are removed
+//     and their mass is counted (a silo outlet);
+//   - mass-flow planes: the net mass whose centres crossed a plane;
+//   - the mass balance per subdomain, inserted - present - removed, kept in
+//     integer units of 1e-18 kg so that it is exact (no round-off): every
+//     particle's mass is quantised once, from the same double, on the way in,
+//     on the way out and while present.
+// Everything here runs between steps, never inside one: a pour or a removal
+// changes the store's layout, and the subdomain rebuilds its neighbour list
+// at its next step (ParticleStore::layout_version). Checks are therefore
+// batched at an interval (deletion regions: 0.005 s by default) so that a
+// steady outflow costs one list build per interval, not one per particle.
+#pragma once
+
+#include "loader/plugin_registry.hpp"
+#include "subdomain/subdomain.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace domel::platform {
+
+/// Exact mass in units of 1e-18 kg (a particle of up to ~9 kg; sums in 128 bits).
+using MassUnits = __int128;
+MassUnits mass_units(double kg);
+double mass_kg(MassUnits u);
+
+struct MassAccount {
+  MassUnits inserted = 0;
+  MassUnits removed = 0;
+  std::uint64_t n_inserted = 0;
+  std::uint64_t n_removed = 0;
+};
+
+/// A cumulative series sampled at the probe rows, with its rate.
+struct FlowSeries {
+  std::vector<double> t, value;
+  /// least-squares slope of value(t) over [t0, t1] (NaN with fewer than 3 rows)
+  double slope(double t0, double t1) const;
+};
+
+struct Pour {
+  std::string where;        ///< JSON pointer of the block, for messages
+  std::size_t subdomain = 0;
+  std::shared_ptr<ModelInstance> model;
+  domel_region_v1 region{};
+  double velocity[3] = {0, 0, 0};
+  bool fixed = false;
+  double density = 0;
+  double alpha = 1;
+  double mass_rate = 0;     ///< [kg/s]
+  double total_mass = std::numeric_limits<double>::infinity();  ///< [kg]
+  double start = 0, end = std::numeric_limits<double>::infinity();  ///< [s]
+  double interval = 0;      ///< [s] between insertion events
+  std::uint64_t seed = 0;
+  // state
+  std::uint64_t events = 0;
+  std::uint64_t inserted = 0;
+  double inserted_mass = 0;  ///< [kg]
+  double shortfall = 0;      ///< [kg] largest deficit against the rate seen after an event
+  bool warned = false;
+};
+
+struct DeletionRegion {
+  std::string name;
+  domel_region_v1 region{};
+  double rate_window[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  std::uint64_t removed = 0;
+  double removed_mass = 0;  ///< [kg], all subdomains
+  FlowSeries series;
+};
+
+struct MassFlowPlane {
+  std::string name;
+  double p[3] = {0, 0, 0};
+  double n[3] = {0, 0, 1};
+  double rate_window[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  std::vector<std::unordered_map<std::uint64_t, signed char>> side;  ///< per subdomain: id -> side at the last check
+  double mass = 0;          ///< [kg] net mass crossed along n
+  std::int64_t count = 0;   ///< net particles crossed along n
+  FlowSeries series;
+};
+
+class ParticleFlow {
+ public:
+  std::vector<Pour> pours;
+  std::vector<DeletionRegion> deletions;
+  std::vector<MassFlowPlane> planes;
+  double deletion_interval = 0.005;  ///< [s] between deletion (and plane) checks
+  std::uint64_t next_id = 1;         ///< id of the next inserted particle
+  double gravity[3] = {0, 0, -9.81};
+
+  bool empty() const { return pours.empty() && deletions.empty() && planes.empty(); }
+
+  /// Before the first step: every particle present counts as inserted.
+  void start(std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  /// At simulated time t (the start of a macro step): pours and checks that are due.
+  void update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  /// Plane crossings up to now (also called at every probe row and at the end).
+  void check_planes(std::vector<std::unique_ptr<Subdomain>>& subdomains);
+
+  std::vector<std::string> columns() const;
+  /// Append this row's values (cumulative masses and rates since the last row).
+  void append_row(double t, std::vector<double>& row);
+  nlohmann::json summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains) const;
+  /// inserted - present - removed [kg] of subdomain k: exactly 0 unless a particle was lost or duplicated
+  MassUnits residual(std::size_t k, const ParticleStore& s) const;
+  const std::vector<MassAccount>& accounts() const { return accounts_; }
+
+ private:
+  void pour(Pour& p, double t, Subdomain& sd);
+  void delete_particles(std::vector<std::unique_ptr<Subdomain>>& subdomains);
+
+  std::vector<MassAccount> accounts_;
+  double next_check_ = 0;
+  double last_row_t_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> last_row_;
+};
+
+}  // namespace domel::platform
