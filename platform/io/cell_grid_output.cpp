@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: MIT
+// CellGridVtkSeries builds a vtkImageData whose cells are the grid's cells
+// (VTK orders cell data x fastest, then y, then z, the same flattening as
+// CellFields), writes it with vtkXMLImageDataWriter under a temporary name and
+// renames it into place, then regenerates the .pvd text and writes it with
+// write_file_atomically(). CellGridProfileCsv appends the layer profile rows
+// to a CsvSeries and flushes it.
+#include "io/cell_grid_output.hpp"
+
+#include <charconv>
+#include <cstdio>
+#include <stdexcept>
+#include <system_error>
+#include <utility>
+
+#include <unistd.h>
+
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkXMLImageDataWriter.h>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace domel::platform::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The two helpers below repeat those of io/vtk_writer.cpp (kept private
+// there); if a third writer needs them they belong in a shared header.
+
+/// Shortest text that reads back as the same double (locale independent).
+std::string format_double(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+/// Escape the characters that may not appear verbatim in an XML attribute.
+std::string xml_attribute(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// A cell-data array of `comps` components copied from `values`.
+void add_array(vtkCellData* cd, const char* name, const std::vector<double>& values, int comps,
+               std::size_t cells) {
+  if (values.size() != cells * static_cast<std::size_t>(comps)) {
+    throw std::invalid_argument(std::string("CellGridVtkSeries::write: field '") + name + "' has " +
+                                std::to_string(values.size()) + " values, expected " +
+                                std::to_string(cells * static_cast<std::size_t>(comps)));
+  }
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->SetNumberOfComponents(comps);
+  a->SetNumberOfTuples(static_cast<vtkIdType>(cells));
+  std::copy(values.begin(), values.end(), a->GetPointer(0));
+  cd->AddArray(a);
+}
+
+void ensure_directory(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw RuntimeError("cannot create output directory '" + dir.string() + "': " + ec.message());
+}
+
+}  // namespace
+
+CellGridVtkSeries::CellGridVtkSeries(fs::path directory, std::string basename)
+    : directory_(std::move(directory)), basename_(std::move(basename)) {
+  if (basename_.empty() || basename_.find('/') != std::string::npos) {
+    throw std::invalid_argument("CellGridVtkSeries: basename must be a non-empty file name, got '" +
+                                basename_ + "'");
+  }
+}
+
+fs::path CellGridVtkSeries::write(double time, const CellGrid& grid, const CellFields& f) {
+  const CellGridSpec& spec = grid.spec();
+  const std::size_t cells = grid.cell_count();
+
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(spec.cells[0] + 1, spec.cells[1] + 1, spec.cells[2] + 1);
+  image->SetOrigin(spec.lo[0], spec.lo[1], spec.lo[2]);
+  image->SetSpacing(grid.cell_size()[0], grid.cell_size()[1], grid.cell_size()[2]);
+
+  if (f.vx.size() != cells || f.vy.size() != cells || f.vz.size() != cells) {
+    throw std::invalid_argument("CellGridVtkSeries::write: velocity does not fit the grid");
+  }
+  std::vector<double> velocity(3 * cells);
+  for (std::size_t c = 0; c < cells; ++c) {
+    velocity[3 * c] = f.vx[c];
+    velocity[3 * c + 1] = f.vy[c];
+    velocity[3 * c + 2] = f.vz[c];
+  }
+  vtkCellData* cd = image->GetCellData();
+  add_array(cd, "count", f.count, 1, cells);
+  add_array(cd, "count_fixed", f.count_fixed, 1, cells);
+  add_array(cd, "mass", f.mass, 1, cells);
+  add_array(cd, "volume_fraction", f.volume_fraction, 1, cells);
+  add_array(cd, "velocity", velocity, 3, cells);
+  add_array(cd, "pressure", f.pressure, 1, cells);
+  add_array(cd, "stress", f.stress, 9, cells);
+  add_array(cd, "stress_kinetic", f.stress_kinetic, 9, cells);
+  add_array(cd, "accessible", f.accessible, 1, cells);
+
+  vtkNew<vtkDoubleArray> time_value;  // the name ParaView reads as the data set's time
+  time_value->SetName("TimeValue");
+  time_value->InsertNextValue(time);
+  image->GetFieldData()->AddArray(time_value);
+  vtkNew<vtkDoubleArray> samples;
+  samples->SetName("samples");
+  samples->InsertNextValue(static_cast<double>(f.samples));
+  image->GetFieldData()->AddArray(samples);
+
+  ensure_directory(directory_);
+  char index[32];
+  std::snprintf(index, sizeof index, "%06zu", frames_.size());
+  const std::string file = basename_ + "_" + index + ".vti";
+  const fs::path target = directory_ / file;
+  fs::path tmp = target;
+  tmp += ".tmp-" + std::to_string(static_cast<long long>(::getpid()));
+
+  std::error_code ec;
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  writer->SetFileName(tmp.c_str());
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToZLib();
+  writer->SetHeaderTypeToUInt64();
+  const int ok = writer->Write();
+  if (ok != 1 || writer->GetErrorCode() != 0) {
+    fs::remove(tmp, ec);
+    throw RuntimeError("cannot write file '" + target.string() + "': vtkXMLImageDataWriter failed");
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    fs::remove(tmp, ec);
+    throw RuntimeError("cannot write file '" + target.string() + "': cannot rename '" + tmp.string() +
+                       "' onto it: " + why);
+  }
+  frames_.push_back(Frame{time, file});
+
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"Collection\" version=\"0.1\">\n"
+      "  <Collection>\n";
+  for (const Frame& fr : frames_) {
+    xml += "    <DataSet timestep=\"" + format_double(fr.time) + "\" group=\"\" part=\"0\" file=\"" +
+           xml_attribute(fr.file) + "\"/>\n";
+  }
+  xml +=
+      "  </Collection>\n"
+      "</VTKFile>\n";
+  write_file_atomically(directory_ / (basename_ + ".pvd"), xml);
+  return target;
+}
+
+namespace {
+
+int checked_axis(int axis) {
+  if (axis < 0 || axis > 2) {
+    throw std::invalid_argument("CellGridProfileCsv: axis must be 0, 1 or 2, got " + std::to_string(axis));
+  }
+  return axis;
+}
+
+}  // namespace
+
+CellGridProfileCsv::CellGridProfileCsv(fs::path directory, const std::string& name, int axis)
+    : directory_(std::move(directory)),
+      path_(directory_ / (name + "_profile.csv")),
+      axis_(checked_axis(axis)),
+      csv_(path_,
+           {"time", "layer", "centre", "accessible_volume", "count", "volume_fraction", "pressure", "vx", "vy",
+            "vz"},
+           // never flush on its own: write() flushes once per output time
+           static_cast<std::size_t>(-1)) {}
+
+void CellGridProfileCsv::write(double time, const CellGrid& grid, const CellFields& f) {
+  const LayerProfile p = grid.profile(f, axis_);
+  for (std::size_t L = 0; L < p.centre.size(); ++L) {
+    csv_.append({time, static_cast<double>(L), p.centre[L], p.accessible_volume[L], p.count[L],
+                 p.volume_fraction[L], p.pressure[L], p.vx[L], p.vy[L], p.vz[L]});
+  }
+  ensure_directory(directory_);
+  csv_.flush();
+}
+
+}  // namespace domel::platform::io

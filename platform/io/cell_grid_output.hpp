@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+// Output of the Eulerian cell averages (averaging/cell_grid.hpp): a ParaView
+// time series of VTK ImageData files (.vti, one per output time, the fields
+// as cell data) with a .pvd collection, and a CSV of the layer profile along
+// one axis (one row per layer per output time) for "pressure over height"
+// plots. Every file is replaced atomically, like the particle series
+// (io/vtk_writer.hpp), so both can be opened while the run goes on.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "averaging/cell_grid.hpp"
+#include "io/csv_series.hpp"
+
+namespace domel::platform::io {
+
+/// ParaView grid series: <dir>/<basename>_<000000>.vti plus <dir>/<basename>.pvd.
+/// The directory is created (with parents) on the first write.
+class CellGridVtkSeries {
+ public:
+  /// Throws std::invalid_argument if `basename` is empty or contains a '/'.
+  CellGridVtkSeries(std::filesystem::path directory, std::string basename);
+
+  /// Writes one .vti: an image with the grid's origin (lo), spacing (cell
+  /// size) and cells, cell-data arrays "count", "count_fixed", "mass",
+  /// "volume_fraction", "velocity" (3 components), "pressure", "stress" and
+  /// "stress_kinetic" (9 components, row-major, > 0 in compression),
+  /// "accessible"; field data "TimeValue" and "samples". Binary appended,
+  /// zlib-compressed, written under a temporary name then renamed; then the
+  /// .pvd listing every file so far is rewritten atomically. Throws
+  /// std::invalid_argument when `f` does not fit the grid, RuntimeError when
+  /// a file cannot be written. Returns the path of the .vti.
+  std::filesystem::path write(double time, const CellGrid& grid, const CellFields& f);
+
+  std::size_t files_written() const { return frames_.size(); }
+
+ private:
+  struct Frame {
+    double time;
+    std::string file;  ///< relative to directory_
+  };
+  std::filesystem::path directory_;
+  std::string basename_;
+  std::vector<Frame> frames_;
+};
+
+/// The layer profile as a CSV time series, <dir>/<name>_profile.csv, columns
+/// time, layer, centre, accessible_volume, count, volume_fraction, pressure,
+/// vx, vy, vz (SI units; see LayerProfile). The directory is created on the
+/// first write; the file is rewritten atomically after every write().
+class CellGridProfileCsv {
+ public:
+  /// Throws std::invalid_argument for an axis other than 0, 1, 2.
+  CellGridProfileCsv(std::filesystem::path directory, const std::string& name, int axis = 2);
+
+  /// Appends one row per layer of grid.profile(f, axis) and flushes.
+  void write(double time, const CellGrid& grid, const CellFields& f);
+
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path directory_;
+  std::filesystem::path path_;
+  int axis_;
+  CsvSeries csv_;
+};
+
+}  // namespace domel::platform::io
