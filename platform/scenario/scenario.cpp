@@ -782,6 +782,57 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
         for (int a = 0; a < 2; ++a) pl.rate_window[a] = d["rate_window"][a].get<double>();
       sim->flow.planes.push_back(pl);
     }
+  if (doc.contains("output") && doc["output"].contains("grids")) {
+    const json& gs = doc["output"]["grids"];
+    for (std::size_t g = 0; g < gs.size(); ++g) {
+      const json& gj = gs[g];
+      Simulation::GridSetup setup;
+      setup.spec.name = gj["name"].get<std::string>();
+      for (int a = 0; a < 3; ++a) {
+        setup.spec.lo[a] = gj["min"][a].get<double>();
+        setup.spec.hi[a] = gj["max"][a].get<double>();
+        setup.spec.cells[a] = gj["cells"][a].get<int>();
+      }
+      setup.spec.every = gj.value("every", 15);
+      setup.spec.write_interval = -1.0;  // default set below, once the duration is known
+      if (gj.contains("write_interval")) setup.spec.write_interval = gj["write_interval"].get<double>();
+      setup.spec.accessible_samples = gj.value("accessible_samples", 8);
+      setup.profile_axis = axis_index(member(gj, "profile_axis"));
+      if (gj.contains("subdomain")) {
+        const std::string want = gj["subdomain"].get<std::string>();
+        std::vector<std::string> names;
+        bool found = false;
+        for (std::size_t k = 0; k < sim->subdomains.size(); ++k) {
+          names.push_back(sim->subdomains[k]->name());
+          if (names.back() == want) {
+            setup.subdomain = k;
+            found = true;
+          }
+        }
+        if (!found) ck.add(idx("/output/grids", g) + "/subdomain", "unknown subdomain '" + want + "'", suggest(want, names));
+      } else if (sim->subdomains.size() > 1) {
+        ck.add(idx("/output/grids", g), "missing required property 'subdomain'",
+               "the scenario has more than one subdomain; name the one this grid averages");
+      }
+      bool corners = true;
+      for (int a = 0; a < 3; ++a)
+        if (setup.spec.hi[a] <= setup.spec.lo[a]) {
+          corners = false;
+          ck.add(idx("/output/grids", g) + "/max/" + std::to_string(a),
+                 "expected max > min along " + std::string(1, "xyz"[a]) + ", found max " + fmt_num(setup.spec.hi[a]) +
+                     " <= min " + fmt_num(setup.spec.lo[a]));
+        }
+      if (corners) try {
+          CellGrid probe(setup.spec);  // the grid's own checks
+        } catch (const std::invalid_argument& e) {
+          ck.add(idx("/output/grids", g), e.what());
+        }
+      for (std::size_t h = 0; h < g; ++h)
+        if (gs[h]["name"] == gj["name"])
+          ck.add(idx("/output/grids", g) + "/name", "duplicate grid name '" + setup.spec.name + "'");
+      sim->grid_setups.push_back(setup);
+    }
+  }
   if (!ck.diags.empty()) throw ConfigError(ck.diags);
 
   if (run.contains("duration")) {
@@ -793,6 +844,8 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   sim->output_directory = out.value("directory", sim->name + "_out");
   sim->vtk_interval = out.value("vtk_interval", sim->duration / 50.0);
   sim->probe_interval = out.value("probe_interval", sim->duration / 500.0);
+  for (auto& g : sim->grid_setups)
+    if (g.spec.write_interval < 0) g.spec.write_interval = sim->duration / 20.0;
   if (out.contains("repose_angle")) {
     const json& r = out["repose_angle"];
     ReposeProbeSettings rp;

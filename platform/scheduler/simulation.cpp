@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
 #include "io/vtk_writer.hpp"
 
@@ -80,6 +81,44 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     for (const auto& sd : subdomains) columns.push_back(sd->name() + ".repose_angle_deg");
   for (const auto& c : flow.columns()) columns.push_back(c);
   flow.start(subdomains);
+
+  // Cell grids: accessible volume from the walls present at the start.
+  grids.clear();
+  std::vector<std::unique_ptr<io::CellGridVtkSeries>> grid_vtk;
+  std::vector<std::unique_ptr<io::CellGridProfileCsv>> grid_csv;
+  std::vector<double> grid_next_write;
+  for (const auto& g : grid_setups) {
+    grids.push_back(std::make_unique<CellGrid>(g.spec));
+    grids.back()->set_accessible(walls, 0.0);
+    grid_vtk.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridVtkSeries>(out, g.spec.name) : nullptr);
+    grid_csv.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridProfileCsv>(out, g.spec.name, g.profile_axis)
+                                                 : nullptr);
+    grid_next_write.push_back(g.spec.write_interval);
+  }
+  auto step_subdomain = [&](std::size_t k) {
+    Subdomain& sd = *subdomains[k];
+    bool record = false;
+    for (std::size_t g = 0; g < grids.size(); ++g)
+      record = record || (grid_setups[g].subdomain == k && grids[g]->due(sd.steps() + 1));
+    sd.set_record_contacts(record);
+    sd.step();
+    if (!record) return;
+    const auto records = sd.contact_records();
+    for (std::size_t g = 0; g < grids.size(); ++g)
+      if (grid_setups[g].subdomain == k && grids[g]->due(sd.steps())) grids[g]->sample(sd.store(), records, sd.time());
+    sd.set_record_contacts(false);
+  };
+  auto write_grids = [&](double t, bool final) {
+    for (std::size_t g = 0; g < grids.size(); ++g) {
+      if (!grid_vtk[g] || (!final && t < grid_next_write[g] - 1e-9 * macro)) continue;
+      if (grids[g]->samples_pending() > 0) {
+        const CellFields f = grids[g]->mean_since_last_take();
+        grid_vtk[g]->write(t, *grids[g], f);
+        grid_csv[g]->write(t, *grids[g], f);
+      }
+      while (grid_next_write[g] <= t + 1e-9 * macro) grid_next_write[g] += grid_setups[g].spec.write_interval;
+    }
+  };
   std::unique_ptr<io::CsvSeries> probes;
   if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
   std::unique_ptr<io::VtkSeriesWriter> vtk;
@@ -133,10 +172,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       write_vtk(t);
       next_vtk += vtk_interval;
     }
+    if (!grids.empty() && m > 0) write_grids(t, false);
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
-      for (int s = 0; s < substeps[k]; ++s) subdomains[k]->step();
+      for (int s = 0; s < substeps[k]; ++s) step_subdomain(k);
       const double ps = static_cast<double>(substeps[k]) * static_cast<double>(subdomains[k]->store().size());
       particle_steps += ps;
       if (options.time_after && m >= options.time_after) window_particle_steps += ps;
@@ -158,6 +198,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const double wall = std::chrono::duration<double>(end - start).count();
   if (options.progress && tty) std::fprintf(stderr, "\n");
   if (probes) probes->flush();
+  write_grids(static_cast<double>(m) * macro, true);
 
   result.macro_steps = m;
   result.simulated_time = static_cast<double>(m) * macro;
@@ -238,6 +279,9 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                                {"particle_steps_per_s", w > 0 ? window_particle_steps / w : 0.0}};
   }
   nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
+  for (std::size_t g = 0; g < grids.size(); ++g)
+    if (grid_vtk[g]) files["grids"][grid_setups[g].spec.name] = {{"series", grid_setups[g].spec.name + ".pvd"},
+                                                                {"profile", grid_setups[g].spec.name + "_profile.csv"}};
   summary["outputs"] = files;
   io::write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
   result.summary = summary;

@@ -5,6 +5,7 @@
 // at fixed simulated-time intervals, and progress is reported.
 #pragma once
 
+#include "averaging/cell_grid.hpp"
 #include "core/material.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
@@ -57,6 +58,16 @@ class Simulation {
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
   ParticleFlow flow;           ///< pours, deletion regions, mass-flow planes, mass balance
+  /// Eulerian cell grids (output.grids): each averages one subdomain's
+  /// particles every `every` of its steps; the latest fields are readable by
+  /// controllers and couplers during the run (CellGrid::latest()).
+  struct GridSetup {
+    CellGridSpec spec;
+    std::size_t subdomain = 0;
+    int profile_axis = 2;
+  };
+  std::vector<GridSetup> grid_setups;
+  std::vector<std::unique_ptr<CellGrid>> grids;  ///< built by run(), same order as grid_setups
 
   /// Run to the end. Throws RuntimeError or PluginError on failure; every
   /// file written up to then is complete (written to a temporary name and renamed).

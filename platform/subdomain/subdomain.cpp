@@ -307,8 +307,15 @@ void Subdomain::compute_forces() {
   contact_forces();
 }
 
+std::vector<const std::vector<ContactRecord>*> Subdomain::contact_records() const {
+  std::vector<const std::vector<ContactRecord>*> out;
+  for (const auto& ts : scratch_) out.push_back(&ts.records);
+  return out;
+}
+
 void Subdomain::contact_forces(bool defer_reduce) {
   last_max_overlap_ratio_ = 0;
+  for (auto& ts : scratch_) ts.records.clear();
   pair_forces(defer_reduce);
   if (reduce_pending_) {
     prune_removed_walls();  // the walls' forces follow in step()'s second pass, per particle range
@@ -619,6 +626,13 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
                stride);
     }
+    if (record_)
+      for (uint32_t q = 0; q < c; ++q) {
+        const uint32_t le = entry[q];
+        const double fn = fn_[q];
+        ts.records.push_back({li[le], lj[le], fn * b_nx[q] + ftx_[q], fn * b_ny[q] + fty_[q], fn * b_nz[q] + ftz_[q],
+                              0.0, 0.0, 0.0});
+      }
     contacts += c;
   }
   ts.n_contacts += contacts;
@@ -674,6 +688,9 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
         s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
         ++s.contacts[i];
         copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
+        if (record_)  // the contact point lies on the wall, ci from the centre along -n
+          ts.records.push_back({i, ContactRecord::kWall, fn * nx + ftx, fn * ny + fty, fn * nz + ftz,
+                                s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz});
       }
       contacts += c;
       c = 0;

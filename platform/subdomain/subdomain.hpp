@@ -8,6 +8,7 @@
 // operators (a later stage) exchange cell averages between them.
 #pragma once
 
+#include "averaging/cell_grid.hpp"
 #include "contact/contact_pipeline.hpp"
 #include "core/material.hpp"
 #include "core/neighbor_list.hpp"
@@ -86,6 +87,13 @@ class Subdomain {
 
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
+
+  /// Record every contact force of the following force evaluations (for the
+  /// cell averages' contact stress; CellGrid::sample). Off by default: a
+  /// sampling step costs one append per contact, other steps nothing.
+  void set_record_contacts(bool on) { record_ = on; }
+  /// The records of the last force evaluation, one list per thread.
+  std::vector<const std::vector<ContactRecord>*> contact_records() const;
   std::size_t neighbor_builds() const { return nlist_.builds(); }
   SubdomainStats stats() const;
 
@@ -97,6 +105,7 @@ class Subdomain {
     std::vector<double> ci, cj;      ///< lever arms of each batch slot
     std::vector<double> fx, fy, fz, tx, ty, tz;  ///< accumulators (threads > 0)
     std::vector<uint32_t> contacts;
+    std::vector<ContactRecord> records;  ///< contact forces on recording steps
     std::size_t n_contacts = 0;
     std::size_t wall_contacts = 0;
     double wall_max_ratio = 0;
@@ -148,6 +157,7 @@ class Subdomain {
   std::size_t split_builds_ = 0;
   bool reduce_pending_ = false;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
+  bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::unique_ptr<ThreadPool> pool_;
 };
