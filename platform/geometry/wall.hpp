@@ -165,8 +165,12 @@ struct WallPrimitive {
     double r[3] = {q[0], q[1], q[2]};
     r[axis] = 0.0;
     const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    if (rho <= 0.0) return false;  // on the axis: no preferred direction (and far from the mantle)
-    const double er[3] = {r[0] / rho, r[1] / rho, r[2] / rho};
+    double er[3] = {0, 0, 0};
+    if (rho > 0.0) {
+      for (int a = 0; a < 3; ++a) er[a] = r[a] / rho;
+    } else {  // exactly on the axis (a sphere seated in the outlet): any radial direction will do
+      er[(axis + 1) % 3] = 1.0;
+    }
     const double tr = radius_hi - radius, ts = hi - lo;
     const double len2 = tr * tr + ts * ts;
     double u = ((rho - radius) * tr + (s - lo) * ts) / len2;
