@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <vector>
 
 namespace dp = domel::platform;
 
@@ -97,4 +99,33 @@ TEST(WallMotion, PlaceAndSurfaceVelocity) {
   EXPECT_DOUBLE_EQ(uy, 0.0);
   w.surface_velocity(3.5, 0.5, 1.0, 0.0, ux, uy, uz);
   EXPECT_EQ(ux, 0.0);
+}
+
+TEST(WallMotion, MeshRotatesAboutAnAxisThroughItsMovingOrigin) {
+  // one triangle, turned a quarter turn about z through (1, 0, 0) while the
+  // origin moves at (0, 0, 1) m/s; its displacement bound covers the motion
+  const std::vector<double> soup = {2, 0, 0, 3, 0, 0, 2, 1, 0};
+  auto mesh = std::make_shared<dp::TriangleMesh>(dp::TriangleMesh::from_soup(soup, 1e-9));
+  dp::WallPrimitive base;
+  base.shape = dp::WallPrimitive::Shape::mesh;
+  base.mesh = mesh;
+  base.verts = mesh->vertices;
+  base.moving = true;
+  base.omega[2] = M_PI / 2;
+  base.velocity[2] = 1.0;
+  base.origin[0] = 1.0;
+  dp::WallPrimitive w = base;
+  w.place(base, 1.0);
+  // (2,0,0) -> origin + R(90)(1,0,0) + (0,0,1) = (1, 1, 1); (3,0,0) -> (1, 2, 1); (2,1,0) -> (0, 1, 1)
+  const double expected[9] = {1, 1, 1, 1, 2, 1, 0, 1, 1};
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(w.verts[k], expected[k], 1e-12) << k;
+  // the moved vertices lie within the bound
+  const double moved = std::hypot(std::hypot(3 - 1.0, 0 - 2.0), 1.0);
+  EXPECT_GE(w.displacement_bound(0.0, 1.0), moved);
+  // surface velocity of the vertex (1, 2, 1): omega x (0, 2, 0) + v = (-pi, 0, 1)
+  double ux, uy, uz;
+  w.surface_velocity(1.0, 1, 2, 1, ux, uy, uz);
+  EXPECT_NEAR(ux, -M_PI, 1e-12);
+  EXPECT_NEAR(uy, 0.0, 1e-12);
+  EXPECT_NEAR(uz, 1.0, 1e-12);
 }
