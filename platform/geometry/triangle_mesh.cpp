@@ -318,8 +318,24 @@ void TriangleGrid::query(double x, double y, double z, std::vector<uint32_t>& ou
   out.insert(out.end(), items_.begin() + start_[cellid], items_.begin() + start_[cellid + 1]);
 }
 
+void triangle_bounds(const TriangleMesh& mesh, const std::vector<double>& verts, std::vector<double>& bounds) {
+  const std::size_t nt = mesh.triangle_count();
+  bounds.resize(4 * nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const double* v[3] = {&verts[3 * mesh.tri[3 * t]], &verts[3 * mesh.tri[3 * t + 1]], &verts[3 * mesh.tri[3 * t + 2]]};
+    double c[3];
+    for (int a = 0; a < 3; ++a) c[a] = (v[0][a] + v[1][a] + v[2][a]) / 3.0;
+    double r2 = 0;
+    for (const double* x : v)
+      r2 = std::max(r2, (x[0] - c[0]) * (x[0] - c[0]) + (x[1] - c[1]) * (x[1] - c[1]) + (x[2] - c[2]) * (x[2] - c[2]));
+    for (int a = 0; a < 3; ++a) bounds[4 * t + a] = c[a];
+    bounds[4 * t + 3] = std::sqrt(r2) * (1.0 + 1e-12);
+  }
+}
+
 void resolve_mesh_contacts(const TriangleMesh& mesh, const double* verts, const double p[3], double r,
-                           const uint32_t* tris, std::size_t count, MeshScratch& s, std::vector<MeshContact>& out) {
+                           const uint32_t* tris, std::size_t count, MeshScratch& s, std::vector<MeshContact>& out,
+                           const double* bounds) {
   out.clear();
   s.feature.resize(count);
   s.dist.resize(count);
@@ -352,6 +368,15 @@ void resolve_mesh_contacts(const TriangleMesh& mesh, const double* verts, const 
   // Pass 1: closest features; face contacts count and cover their edges and vertices.
   for (std::size_t k = 0; k < count; ++k) {
     const uint32_t t = tris[k];
+    if (bounds) {  // cheap screen: the sphere cannot reach the triangle's enclosing sphere
+      const double* b = bounds + 4 * t;
+      const double dx = p[0] - b[0], dy = p[1] - b[1], dz = p[2] - b[2], reach = r + b[3];
+      if (dx * dx + dy * dy + dz * dz >= reach * reach) {
+        s.feature[k] = 255;
+        s.dist[k] = r;
+        continue;
+      }
+    }
     const uint32_t* tv = &mesh.tri[3 * t];
     double* q = &s.q[3 * k];
     const TriangleFeature f = closest_on_triangle(p, &verts[3 * tv[0]], &verts[3 * tv[1]], &verts[3 * tv[2]], q);

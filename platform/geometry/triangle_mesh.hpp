@@ -110,8 +110,16 @@ struct MeshScratch {
 /// only if no triangle containing it has a face contact and no counted edge
 /// contact ends at it. A triangle's own face contact covers its three edges
 /// and vertices, so no adjacency lookup is needed.
+///
+/// `bounds` (4 per triangle: centre and radius of a sphere enclosing it, see
+/// triangle_bounds()) screens out the candidates that cannot touch before
+/// their closest point is computed; may be null.
 void resolve_mesh_contacts(const TriangleMesh& mesh, const double* verts, const double p[3], double r,
                            const uint32_t* tris, std::size_t count, MeshScratch& scratch,
-                           std::vector<MeshContact>& out);
+                           std::vector<MeshContact>& out, const double* bounds = nullptr);
+
+/// Enclosing spheres of the triangles at vertex positions `verts`: centroid
+/// and largest centroid-corner distance, 4 doubles per triangle.
+void triangle_bounds(const TriangleMesh& mesh, const std::vector<double>& verts, std::vector<double>& bounds);
 
 }  // namespace domel::platform

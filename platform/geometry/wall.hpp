@@ -52,6 +52,7 @@ struct WallPrimitive {
   // mesh: the reference geometry and the current vertex positions (x, y, z per vertex)
   std::shared_ptr<const TriangleMesh> mesh;
   std::vector<double> verts;
+  std::vector<double> tri_bounds;  ///< enclosing sphere per triangle at `verts` (triangle_bounds())
   /// simulated time from which the wall is gone (an outlet plug, a lifted cylinder)
   double remove_at = std::numeric_limits<double>::infinity();
   /// simulated time from which the wall acts (an outlet that opens); contacts start with zero history
@@ -110,6 +111,7 @@ struct WallPrimitive {
       for (int a = 0; a < 3; ++a)
         verts[v + a] = origin[a] + offset[a] + r[a] * cs + kxr[a] * sn + k[a] * kr * (1.0 - cs);
     }
+    triangle_bounds(*mesh, verts, tri_bounds);
   }
 
   /// Velocity of the surface point (x, y, z) at time t: v + omega x (x - origin(t)).

@@ -614,6 +614,7 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
     m.name = name;
     m.material = material;
     m.verts = mesh->vertices;
+    triangle_bounds(*mesh, m.verts, m.tri_bounds);
     m.mesh = std::move(mesh);
     out.push_back(std::move(m));
   }

@@ -753,7 +753,7 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
         const std::size_t count = e_end - e;
         const double p[3] = {s.x[i], s.y[i], s.z[i]};
         resolve_mesh_contacts(*wall.mesh, wall.verts.data(), p, s.radius[i], list.triangle.data() + e, count,
-                              ts.mesh, ts.mesh_out);
+                              ts.mesh, ts.mesh_out, wall.tri_bounds.empty() ? nullptr : wall.tri_bounds.data());
         ts.counted.assign(count, 0);
         for (const MeshContact& mc : ts.mesh_out) ts.counted[mc.slot] = 1;
         std::size_t released = SIZE_MAX;
