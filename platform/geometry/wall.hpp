@@ -1,54 +1,253 @@
 // SPDX-License-Identifier: MIT
-// Wall primitives. Scenario walls (plane, box container, cylinder container)
-// are expanded into primitives: an infinite plane, or the inside of a finite
-// axis-aligned cylinder mantle. A primitive answers one question per
-// particle: how far is the sphere centre from the surface (on the particle
-// side), and along which unit normal (from the wall towards the centre).
+// Wall primitives. Scenario walls (plane, box, cylinder and cone containers,
+// disk, triangle mesh) are expanded into primitives: an infinite plane, the
+// inside of a finite axis-aligned cylinder mantle, the inside of an
+// axis-aligned frustum (cone) mantle, a flat annulus (a disk, or a plate with
+// a round hole), or a triangle mesh. An analytic primitive answers one
+// question per particle: how far is the sphere centre from the surface (on
+// the particle side), and along which unit normal (from the wall towards the
+// centre). Meshes have many features per particle and are evaluated by
+// mesh_contacts() (geometry/triangle_mesh.hpp) instead of gap().
+//
+// A primitive may move (WallPrimitive::moving): a constant translation
+// velocity and a constant angular velocity about an axis through `origin`,
+// between `motion_start` and `motion_end`. place() moves the geometry to a
+// given time; surface_velocity() gives the velocity of a surface point.
+// Analytic primitives rotate only about their own axis (their geometry does
+// not change, only the surface velocity); meshes rotate about any axis.
 #pragma once
 
+#include "geometry/triangle_mesh.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <string>
+#include <vector>
 
 namespace domel::platform {
 
 struct WallPrimitive {
-  enum class Shape { plane, cylinder_inside };
+  enum class Shape { plane, cylinder_inside, cone_inside, annulus, mesh };
   Shape shape = Shape::plane;
   std::string name;          ///< e.g. "container.zmin"
   std::size_t material = 0;  ///< index into the scenario's materials
   // plane: a point on it and the unit normal pointing to the particles' side
+  // annulus: its centre and the unit normal pointing to the particles' side
   double p[3] = {0, 0, 0};
   double n[3] = {0, 0, 1};
-  // cylinder mantle, particles inside: axis 0/1/2, axis passes through c,
-  // radius, extent [lo, hi] along the axis (no contact outside it)
+  // cylinder / cone mantle, particles inside: axis 0/1/2, axis passes through
+  // c, radius (cone: radius at lo), radius_hi (cone: radius at hi), extent
+  // [lo, hi] along the axis
   int axis = 2;
   double c[3] = {0, 0, 0};
   double radius = 0.0;
+  double radius_hi = 0.0;
   double lo = 0.0, hi = 0.0;
+  // annulus: inner (hole) and outer radius; no contact beyond the outer one
+  double r_inner = 0.0;
+  double r_outer = std::numeric_limits<double>::infinity();
+  // mesh: the reference geometry and the current vertex positions (x, y, z per vertex)
+  std::shared_ptr<const TriangleMesh> mesh;
+  std::vector<double> verts;
+  std::vector<double> tri_bounds;  ///< enclosing sphere per triangle at `verts` (triangle_bounds())
   /// simulated time from which the wall is gone (an outlet plug, a lifted cylinder)
   double remove_at = std::numeric_limits<double>::infinity();
+  /// simulated time from which the wall acts (an outlet that opens); contacts start with zero history
+  double active_from = -std::numeric_limits<double>::infinity();
+
+  // motion: translation velocity, angular velocity about an axis through origin
+  bool moving = false;
+  double velocity[3] = {0, 0, 0};
+  double omega[3] = {0, 0, 0};
+  double origin[3] = {0, 0, 0};
+  double motion_start = 0.0;
+  double motion_end = std::numeric_limits<double>::infinity();
+  double offset[3] = {0, 0, 0};  ///< translation applied by the last place()
+  double angle = 0.0;            ///< rotation angle applied by the last place() [rad]
+
+  bool active(double t) const { return t >= active_from && t < remove_at; }
+
+  /// Time spent moving up to t.
+  double elapsed(double t) const { return std::max(0.0, std::min(t, motion_end) - motion_start); }
+
+  /// Upper bound of how far any surface point moved between the elapsed
+  /// motion times e0 and e1 (the wall list is rebuilt beyond skin/2).
+  double displacement_bound(double e0, double e1) const {
+    const double de = std::fabs(e1 - e0);
+    const double v = std::sqrt(velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2]);
+    double rot = 0.0;
+    if (shape == Shape::mesh && mesh) {
+      const double w = std::sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2]);
+      rot = w * de * mesh->max_distance_from(origin);  // chord <= arc
+    }
+    return v * de + rot;
+  }
+
+  /// Move the geometry of `base` (this primitive's reference state) to time t.
+  void place(const WallPrimitive& base, double t) {
+    const double e = elapsed(t);
+    for (int a = 0; a < 3; ++a) offset[a] = velocity[a] * e;
+    for (int a = 0; a < 3; ++a) {
+      p[a] = base.p[a] + offset[a];
+      c[a] = base.c[a] + offset[a];
+    }
+    lo = base.lo + offset[axis];
+    hi = base.hi + offset[axis];
+    if (shape != Shape::mesh || !mesh) return;
+    const double w = std::sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2]);
+    angle = w * e;
+    // Rodrigues' rotation formula about the unit axis k through origin.
+    const double k[3] = {w > 0 ? omega[0] / w : 0, w > 0 ? omega[1] / w : 0, w > 0 ? omega[2] / w : 1};
+    const double cs = std::cos(angle), sn = std::sin(angle);
+    const std::vector<double>& ref = mesh->vertices;
+    verts.resize(ref.size());
+    for (std::size_t v = 0; v < ref.size(); v += 3) {
+      const double r[3] = {ref[v] - origin[0], ref[v + 1] - origin[1], ref[v + 2] - origin[2]};
+      const double kr = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
+      const double kxr[3] = {k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2], k[0] * r[1] - k[1] * r[0]};
+      for (int a = 0; a < 3; ++a)
+        verts[v + a] = origin[a] + offset[a] + r[a] * cs + kxr[a] * sn + k[a] * kr * (1.0 - cs);
+    }
+    triangle_bounds(*mesh, verts, tri_bounds);
+  }
+
+  /// Velocity of the surface point (x, y, z) at time t: v + omega x (x - origin(t)).
+  void surface_velocity(double t, double x, double y, double z, double& ux, double& uy, double& uz) const {
+    if (!moving || t < motion_start || t >= motion_end) {
+      ux = uy = uz = 0.0;
+      return;
+    }
+    const double rx = x - origin[0] - offset[0], ry = y - origin[1] - offset[1], rz = z - origin[2] - offset[2];
+    ux = velocity[0] + omega[1] * rz - omega[2] * ry;
+    uy = velocity[1] + omega[2] * rx - omega[0] * rz;
+    uz = velocity[2] + omega[0] * ry - omega[1] * rx;
+  }
 
   /// Distance `d` of the point from the surface (positive on the particle
   /// side) and unit normal (nx, ny, nz) from the wall to the point. Returns
-  /// false when the point has no defined contact (outside a mantle's extent).
+  /// false when the point has no defined contact (outside a mantle's extent,
+  /// beyond an annulus' outer radius). Not for meshes.
   bool gap(double x, double y, double z, double& d, double& nx, double& ny, double& nz) const {
-    if (shape == Shape::plane) {
-      d = (x - p[0]) * n[0] + (y - p[1]) * n[1] + (z - p[2]) * n[2];
+    switch (shape) {
+      case Shape::plane:
+        d = (x - p[0]) * n[0] + (y - p[1]) * n[1] + (z - p[2]) * n[2];
+        nx = n[0]; ny = n[1]; nz = n[2];
+        return true;
+      case Shape::cylinder_inside: {
+        const double q[3] = {x - c[0], y - c[1], z - c[2]};
+        const double along = (axis == 0 ? x : axis == 1 ? y : z);
+        if (along < lo || along > hi) return false;
+        double rx = q[0], ry = q[1], rz = q[2];
+        if (axis == 0) rx = 0; else if (axis == 1) ry = 0; else rz = 0;
+        const double rho = std::sqrt(rx * rx + ry * ry + rz * rz);
+        if (rho <= 0.0) return false;
+        d = radius - rho;
+        nx = -rx / rho; ny = -ry / rho; nz = -rz / rho;
+        return true;
+      }
+      case Shape::cone_inside: return cone_gap(x, y, z, d, nx, ny, nz);
+      case Shape::annulus: return annulus_gap(x, y, z, d, nx, ny, nz);
+      case Shape::mesh: return false;
+    }
+    return false;
+  }
+
+  /// Frustum mantle. In the half-plane (rho, s) through the axis and the
+  /// point, the mantle is the segment from (radius, lo) to (radius_hi, hi);
+  /// the contact point is the closest point of that segment (a point
+  /// projected past an end meets the rim circle: an edge contact, normal
+  /// from the rim to the centre, from any side). On the segment's interior
+  /// the distance is signed, positive on the axis side.
+  bool cone_gap(double x, double y, double z, double& d, double& nx, double& ny, double& nz) const {
+    const double q[3] = {x - c[0], y - c[1], z - c[2]};
+    const double s = (axis == 0 ? x : axis == 1 ? y : z);
+    double r[3] = {q[0], q[1], q[2]};
+    r[axis] = 0.0;
+    const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    double er[3] = {0, 0, 0};
+    if (rho > 0.0) {
+      for (int a = 0; a < 3; ++a) er[a] = r[a] / rho;
+    } else {  // exactly on the axis (a sphere seated in the outlet): any radial direction will do
+      er[(axis + 1) % 3] = 1.0;
+    }
+    const double tr = radius_hi - radius, ts = hi - lo;
+    const double len2 = tr * tr + ts * ts;
+    double u = ((rho - radius) * tr + (s - lo) * ts) / len2;
+    double dr, ds;  // point minus closest point, in (rho, s)
+    if (u > 0.0 && u < 1.0) {
+      const double len = std::sqrt(len2);
+      const double mr = -ts / len, ms = tr / len;  // inward unit normal of the segment
+      d = (rho - radius) * mr + (s - lo) * ms;
+      dr = mr; ds = ms;
+    } else {
+      u = u <= 0.0 ? 0.0 : 1.0;
+      dr = rho - (radius + u * tr);
+      ds = s - (lo + u * ts);
+      d = std::sqrt(dr * dr + ds * ds);
+      if (d <= 0.0) return false;
+      dr /= d; ds /= d;
+    }
+    double nv[3] = {dr * er[0], dr * er[1], dr * er[2]};
+    nv[axis] += ds;
+    nx = nv[0]; ny = nv[1]; nz = nv[2];
+    return true;
+  }
+
+  /// Flat annulus r_inner <= rho <= r_outer in the plane through p with
+  /// normal n: a face contact over the annulus (one-sided, like a plane),
+  /// an edge contact with the nearest point of the inner rim inside the hole
+  /// (from either side), no contact beyond the outer radius.
+  bool annulus_gap(double x, double y, double z, double& d, double& nx, double& ny, double& nz) const {
+    const double q[3] = {x - p[0], y - p[1], z - p[2]};
+    const double h = q[0] * n[0] + q[1] * n[1] + q[2] * n[2];
+    const double r[3] = {q[0] - h * n[0], q[1] - h * n[1], q[2] - h * n[2]};
+    const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    if (rho > r_outer) return false;
+    if (rho >= r_inner) {
+      d = h;
       nx = n[0]; ny = n[1]; nz = n[2];
       return true;
     }
-    const double q[3] = {x - c[0], y - c[1], z - c[2]};
-    const double along = (axis == 0 ? x : axis == 1 ? y : z);
-    if (along < lo || along > hi) return false;
-    double rx = q[0], ry = q[1], rz = q[2];
-    if (axis == 0) rx = 0; else if (axis == 1) ry = 0; else rz = 0;
-    const double rho = std::sqrt(rx * rx + ry * ry + rz * rz);
-    if (rho <= 0.0) return false;
-    d = radius - rho;
-    nx = -rx / rho; ny = -ry / rho; nz = -rz / rho;
+    const double dr = rho - r_inner;  // < 0: the rim is farther out than the point
+    d = std::sqrt(dr * dr + h * h);
+    if (d <= 0.0) return false;
+    if (rho <= 1e-12 * r_inner) {  // on the hole's axis: the whole rim is equidistant; push along the axis
+      const double sgn = h >= 0 ? 1.0 : -1.0;
+      nx = sgn * n[0]; ny = sgn * n[1]; nz = sgn * n[2];
+      return true;
+    }
+    const double a = dr / (d * rho), b = h / d;
+    nx = a * r[0] + b * n[0]; ny = a * r[1] + b * n[1]; nz = a * r[2] + b * n[2];
     return true;
+  }
+
+  /// Conservative list-build test: may a sphere of radius `reach` (radius +
+  /// skin) centred at the point touch this primitive?
+  bool near(double x, double y, double z, double reach) const {
+    double d, nx, ny, nz;
+    switch (shape) {
+      case Shape::cylinder_inside: {
+        if (gap(x, y, z, d, nx, ny, nz)) return d < reach;
+        const double along = (axis == 0 ? x : axis == 1 ? y : z);
+        return along >= lo - reach && along <= hi + reach;
+      }
+      case Shape::annulus: {
+        const double q[3] = {x - p[0], y - p[1], z - p[2]};
+        const double h = q[0] * n[0] + q[1] * n[1] + q[2] * n[2];
+        const double r[3] = {q[0] - h * n[0], q[1] - h * n[1], q[2] - h * n[2]};
+        const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        if (rho > r_outer + reach) return false;
+        if (rho > r_outer) return h < reach;
+        return gap(x, y, z, d, nx, ny, nz) && d < reach;
+      }
+      case Shape::cone_inside:
+        if (gap(x, y, z, d, nx, ny, nz)) return d < reach;
+        return true;  // on the axis: keep it (rare, cheap)
+      default: return gap(x, y, z, d, nx, ny, nz) && d < reach;
+    }
   }
 };
 

@@ -8,43 +8,81 @@
 
 namespace domel::platform {
 
-void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride) {
-  if (!std::isinf(w.remove_at) && w.remove_at <= 0.0) {  // removed from the start
-    *this = WallNeighbors{};
+void WallNeighbors::clear() {
+  particle.clear();
+  particle_id.clear();
+  triangle.clear();
+  history.clear();
+  touching.clear();
+  built = false;
+}
+
+void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active) {
+  if (!active) {
+    clear();
     return;
   }
-  std::unordered_map<std::uint64_t, std::size_t> old;
+  const bool is_mesh = w.shape == WallPrimitive::Shape::mesh;
+  // live contacts by (particle id, triangle)
+  using Key = std::pair<std::uint64_t, uint32_t>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const { return std::hash<std::uint64_t>()(k.first * 0x9E3779B97F4A7C15ull ^ k.second); }
+  };
+  std::unordered_map<Key, std::size_t, KeyHash> old;
+  auto key = [&](std::size_t k) { return Key{particle_id[k], is_mesh ? triangle[k] : 0u}; };
   std::vector<double> old_history;
   old_history.swap(history);
   for (std::size_t k = 0; k < particle.size(); ++k)
-    if (touching[k]) old.emplace(particle_id[k], k);
+    if (touching[k]) old.emplace(key(k), k);
   particle.clear();
   particle_id.clear();
+  triangle.clear();
   touching.clear();
-  for (std::size_t k = 0; k < s.size(); ++k) {
-    double d, nx, ny, nz;
-    if (!w.gap(s.x[k], s.y[k], s.z[k], d, nx, ny, nz)) {
-      // outside a mantle's extent now, but may enter within the skin
-      if (w.shape == WallPrimitive::Shape::cylinder_inside) {
-        const double along = (w.axis == 0 ? s.x[k] : w.axis == 1 ? s.y[k] : s.z[k]);
-        if (along < w.lo - s.radius[k] - skin || along > w.hi + s.radius[k] + skin) continue;
-        particle.push_back(static_cast<uint32_t>(k));
-      }
-      continue;
+  if (is_mesh) {
+    double rmax = 0;
+    for (double r : s.radius) rmax = std::max(rmax, r);
+    const double reach = rmax + skin;
+    if (!grid_valid_ || reach > grid_reach_ || grid_elapsed_ != built_elapsed || w.moving) {
+      grid_.build(w.verts, *w.mesh, reach);
+      grid_valid_ = true;
+      grid_reach_ = reach;
+      grid_elapsed_ = built_elapsed;
     }
-    if (d < s.radius[k] + skin) particle.push_back(static_cast<uint32_t>(k));
+    const TriangleMesh& m = *w.mesh;
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      query_.clear();
+      grid_.query(s.x[k], s.y[k], s.z[k], query_);
+      if (query_.empty()) continue;
+      std::sort(query_.begin(), query_.end());
+      const double p[3] = {s.x[k], s.y[k], s.z[k]};
+      const double lim = s.radius[k] + skin;
+      for (const uint32_t t : query_) {
+        double q[3];
+        closest_on_triangle(p, &w.verts[3 * m.tri[3 * t]], &w.verts[3 * m.tri[3 * t + 1]],
+                            &w.verts[3 * m.tri[3 * t + 2]], q);
+        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        if (dx * dx + dy * dy + dz * dz < lim * lim) {
+          particle.push_back(static_cast<uint32_t>(k));
+          triangle.push_back(t);
+        }
+      }
+    }
+  } else {
+    for (std::size_t k = 0; k < s.size(); ++k)
+      if (w.near(s.x[k], s.y[k], s.z[k], s.radius[k] + skin)) particle.push_back(static_cast<uint32_t>(k));
   }
   for (const uint32_t k : particle) particle_id.push_back(s.id[k]);
   history.assign(particle.size() * stride, 0.0);
   touching.assign(particle.size(), 0);
   if (!old.empty() && stride > 0) {
     for (std::size_t k = 0; k < particle.size(); ++k) {
-      auto it = old.find(particle_id[k]);
+      auto it = old.find(key(k));
       if (it == old.end()) continue;
       std::copy_n(old_history.begin() + it->second * stride, stride, history.begin() + k * stride);
       touching[k] = 1;
     }
   }
+  built = true;
 }
 
 }  // namespace domel::platform

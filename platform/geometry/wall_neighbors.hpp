@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Per-wall candidate lists: the particles within (radius + skin) of one wall
-// primitive, rebuilt with the particle neighbour list, with per-contact
-// history carried across rebuilds and re-ordering by particle id.
+// primitive (for a mesh: the (particle, triangle) pairs within radius +
+// skin), rebuilt with the particle neighbour list or when the wall has moved
+// more than skin/2, with per-contact history carried across rebuilds and
+// re-ordering by particle id (and triangle).
 #pragma once
 
 #include "core/particle_store.hpp"
+#include "geometry/triangle_mesh.hpp"
 #include "geometry/wall.hpp"
 
 #include <cstdint>
@@ -15,11 +18,24 @@ namespace domel::platform {
 /// Candidate particles of one wall primitive, with per-contact history.
 class WallNeighbors {
  public:
-  void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride);
-  std::vector<uint32_t> particle;      ///< particle indices at this build
+  /// Rebuild the candidates of wall `w` (placed at its current position).
+  /// An inactive wall (`active` false) gets an empty list.
+  void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active = true);
+  /// Drop every candidate and its history (a wall that is removed or not yet active).
+  void clear();
+  std::vector<uint32_t> particle;      ///< particle indices at this build (ascending)
   std::vector<std::uint64_t> particle_id;  ///< their ids (history is carried over by id)
+  std::vector<uint32_t> triangle;      ///< mesh walls: the candidate triangle of each entry
   std::vector<double> history;
   std::vector<uint8_t> touching;
+  double built_elapsed = 0.0;          ///< the wall's elapsed motion time at this build
+  bool built = false;                  ///< built while the wall was active
+
+ private:
+  TriangleGrid grid_;
+  bool grid_valid_ = false;
+  double grid_reach_ = 0.0, grid_elapsed_ = -1.0;
+  std::vector<uint32_t> query_;
 };
 
 }  // namespace domel::platform

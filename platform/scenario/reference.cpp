@@ -157,6 +157,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
   const char* blocks[][2] = {{"material", "Material (`materials.<name>`)"},
                              {"interaction", "Interaction (`interactions[]`)"},
                              {"wall", "Wall (`walls[]`)"},
+                             {"wall_motion", "Wall motion (`walls[].motion`)"},
                              {"region", "Region (`insert[].region`)"},
                              {"subdomain", "Subdomain (`subdomains[]`)"},
                              {"contact", "Contact model (`subdomains[].contact`)"},

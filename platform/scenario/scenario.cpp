@@ -3,11 +3,13 @@
 #include "scenario/scenario.hpp"
 
 #include "geometry/region.hpp"
+#include "geometry/triangle_mesh.hpp"
 #include "scenario/json_schema.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -224,13 +226,23 @@ void check_references(Checker& ck, const json& doc) {
   std::set<std::string> wall_names;
   if (const json* walls = member(doc, "walls"); walls && walls->is_array()) {
     static const std::map<std::string, std::set<std::string>> kAllowed = {
-        {"plane", {"name", "type", "material", "point", "normal", "remove_at"}},
-        {"box", {"name", "type", "material", "min", "max", "open", "remove_at"}},
+        {"plane", {"name", "type", "material", "point", "normal", "remove_at", "motion"}},
+        {"box", {"name", "type", "material", "min", "max", "open", "remove_at", "motion"}},
         {"cylinder",
          {"name", "type", "material", "axis", "center", "radius", "bottom", "top", "closed_bottom", "closed_top",
-          "remove_at"}}};
+          "outlet_radius", "outlet_open_at", "remove_at", "motion"}},
+        {"cone",
+         {"name", "type", "material", "axis", "center", "bottom", "top", "radius_bottom", "radius_top",
+          "closed_bottom", "outlet_open_at", "remove_at", "motion"}},
+        {"disk", {"name", "type", "material", "center", "normal", "radius", "inner_radius", "remove_at", "motion"}},
+        {"mesh", {"name", "type", "material", "file", "scale", "translate", "remove_at", "motion"}}};
     static const std::map<std::string, std::vector<std::string>> kRequired = {
-        {"plane", {"point", "normal"}}, {"box", {"min", "max"}}, {"cylinder", {"center", "radius", "bottom", "top"}}};
+        {"plane", {"point", "normal"}},
+        {"box", {"min", "max"}},
+        {"cylinder", {"center", "radius", "bottom", "top"}},
+        {"cone", {"center", "bottom", "top", "radius_bottom", "radius_top"}},
+        {"disk", {"center", "normal", "radius"}},
+        {"mesh", {"file"}}};
     for (std::size_t k = 0; k < walls->size(); ++k) {
       const json& w = (*walls)[k];
       const std::string base = idx("/walls", k);
@@ -253,7 +265,11 @@ void check_references(Checker& ck, const json& doc) {
                  }());
       for (const auto& req : kRequired.at(t))
         if (!w.contains(req)) ck.add(base, "missing required property '" + req + "' of a " + t + " wall");
-      if (t == "plane" && is_vec3(member(w, "normal"))) {
+      auto number = [&](const char* key) -> const json* {
+        const json* j = member(w, key);
+        return j && j->is_number() ? j : nullptr;
+      };
+      if ((t == "plane" || t == "disk") && is_vec3(member(w, "normal"))) {
         const json& n = w["normal"];
         const double len = std::sqrt(n[0].get<double>() * n[0].get<double>() + n[1].get<double>() * n[1].get<double>() +
                                      n[2].get<double>() * n[2].get<double>());
@@ -265,12 +281,96 @@ void check_references(Checker& ck, const json& doc) {
             ck.add(base + "/max/" + std::to_string(a),
                    "expected max > min along " + std::string(1, "xyz"[a]) + ", found max " +
                        fmt_num(w["max"][a].get<double>()) + " <= min " + fmt_num(w["min"][a].get<double>()));
-      if (t == "cylinder") {
-        const json* lo = member(w, "bottom");
-        const json* hi = member(w, "top");
-        if (lo && hi && lo->is_number() && hi->is_number() && lo->get<double>() >= hi->get<double>())
+      if (t == "cylinder" || t == "cone") {
+        const json* lo = number("bottom");
+        const json* hi = number("top");
+        if (lo && hi && lo->get<double>() >= hi->get<double>())
           ck.add(base + "/top", "expected top > bottom, found top " + fmt_num(hi->get<double>()) + " <= bottom " +
                                     fmt_num(lo->get<double>()));
+      }
+      if (t == "cylinder") {
+        const json* r = number("radius");
+        const json* ro = number("outlet_radius");
+        if (r && ro && ro->get<double>() >= r->get<double>())
+          ck.add(base + "/outlet_radius",
+                 "expected outlet_radius < radius, found outlet_radius " + fmt_num(ro->get<double>()) +
+                     " >= radius " + fmt_num(r->get<double>()),
+                 "the outlet is a hole in the cylinder's flat bottom");
+        if (ro && member(w, "closed_bottom") && (*member(w, "closed_bottom")) == false)
+          ck.add(base + "/outlet_radius", "an outlet needs the flat bottom, found closed_bottom false",
+                 "remove closed_bottom, or remove outlet_radius for an open-ended tube");
+        if (member(w, "outlet_open_at") && !ro)
+          ck.add(base + "/outlet_open_at", "outlet_open_at needs outlet_radius (the outlet it opens)");
+      }
+      if (t == "cone" && member(w, "outlet_open_at") && !(member(w, "closed_bottom") && (*member(w, "closed_bottom")) == true))
+        ck.add(base + "/outlet_open_at", "outlet_open_at needs closed_bottom: true (the plug it removes)");
+      if (t == "disk") {
+        const json* r = number("radius");
+        const json* ri = number("inner_radius");
+        if (r && ri && ri->get<double>() >= r->get<double>())
+          ck.add(base + "/inner_radius", "expected inner_radius < radius, found inner_radius " +
+                                             fmt_num(ri->get<double>()) + " >= radius " + fmt_num(r->get<double>()));
+      }
+      if (t == "mesh" && member(w, "file") && w["file"].is_string()) {
+        std::filesystem::path f = w["file"].get<std::string>();
+        if (f.is_relative()) f = ck.file.parent_path() / f;
+        try {
+          const TriangleMesh m = load_stl_mesh(f, 1.0, std::array<double, 3>{0, 0, 0}.data());
+          (void)m;
+        } catch (const MeshError& e) {
+          ck.add(base + "/file", e.what(),
+                 std::filesystem::exists(f) ? "export the mesh again as STL (ASCII or binary)"
+                                            : "paths in \"file\" are relative to the scenario's folder");
+        }
+      }
+      if (const json* mo = member(w, "motion"); mo && mo->is_object()) {
+        const json* st = member(*mo, "start");
+        const json* en = member(*mo, "end");
+        if (st && en && st->is_number() && en->is_number() && en->get<double>() <= st->get<double>())
+          ck.add(base + "/motion/end", "expected end > start, found end " + fmt_num(en->get<double>()) +
+                                           " <= start " + fmt_num(st->get<double>()));
+        const json* om = member(*mo, "angular_velocity");
+        if (is_vec3(om) && t != "mesh") {
+          const double wv[3] = {(*om)[0].get<double>(), (*om)[1].get<double>(), (*om)[2].get<double>()};
+          const double wl = std::sqrt(wv[0] * wv[0] + wv[1] * wv[1] + wv[2] * wv[2]);
+          // the wall's own axis: the normal of a plane or disk, the axis of a cylinder or cone
+          double ax[3] = {0, 0, 0};
+          bool have_axis = false;
+          if ((t == "plane" || t == "disk") && is_vec3(member(w, "normal"))) {
+            for (int a = 0; a < 3; ++a) ax[a] = w["normal"][a].get<double>();
+            have_axis = true;
+          } else if (t == "cylinder" || t == "cone") {
+            ax[axis_index(member(w, "axis"))] = 1.0;
+            have_axis = true;
+          }
+          const double al = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+          auto cross_norm = [](const double* a, const double* b) {
+            const double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+            return std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+          };
+          if (wl > 0 && t == "box") {
+            ck.add(base + "/motion/angular_velocity", "a box wall cannot rotate, found a non-zero angular_velocity",
+                   "use a mesh wall for a rotating box, or only a velocity");
+          } else if (wl > 0 && have_axis && al > 0 && cross_norm(wv, ax) > 1e-9 * wl * al) {
+            ck.add(base + "/motion/angular_velocity",
+                   "a " + t + " wall rotates only about its own " + (t == "plane" || t == "disk" ? "normal" : "axis") +
+                       ", found angular_velocity [" + fmt_num(wv[0]) + ", " + fmt_num(wv[1]) + ", " + fmt_num(wv[2]) +
+                       "] not parallel to it",
+                   "use a mesh wall for other rotations");
+          } else if (wl > 0 && have_axis && al > 0 && is_vec3(member(*mo, "origin"))) {
+            const char* ref = t == "plane" ? "point" : "center";
+            if (is_vec3(member(w, ref))) {
+              double d[3];
+              for (int a = 0; a < 3; ++a) d[a] = (*mo)["origin"][a].get<double>() - w[ref][a].get<double>();
+              const double dl = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+              if (cross_norm(d, ax) > 1e-9 * al * std::max(1.0, dl))
+                ck.add(base + "/motion/origin",
+                       "a " + t + " wall rotates only about its own axis, found an origin off the axis through its " +
+                           ref,
+                       "omit origin, or use a mesh wall for an eccentric rotation");
+            }
+          }
+        }
       }
     }
   }
@@ -429,7 +529,7 @@ domel_region_v1 make_region(const json& region) {
   return r;
 }
 
-std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material) {
+std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material, const std::filesystem::path& dir) {
   std::vector<WallPrimitive> out;
   const std::string name = w["name"].get<std::string>();
   const std::string type = w["type"].get<std::string>();
@@ -460,7 +560,7 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
       n[a] = is_min ? 1.0 : -1.0;
       plane(name + "." + faces[f], p, n);
     }
-  } else {
+  } else if (type == "cylinder") {
     WallPrimitive m;
     m.shape = WallPrimitive::Shape::cylinder_inside;
     m.name = name + ".mantle";
@@ -474,20 +574,116 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
     double p[3] = {m.c[0], m.c[1], m.c[2]}, n[3] = {0, 0, 0};
     if (w.value("closed_bottom", true)) {
       p[m.axis] = m.lo; n[m.axis] = 1.0;
-      plane(name + ".bottom", p, n);
+      if (w.contains("outlet_radius")) {
+        // a plate with a round hole; until outlet_open_at a full plane plugs
+        // it (never both at once: the plug's remove_at is the annulus'
+        // active_from, so no particle feels two bottoms)
+        WallPrimitive a;
+        a.shape = WallPrimitive::Shape::annulus;
+        a.name = name + ".bottom";
+        a.material = material;
+        for (int k = 0; k < 3; ++k) { a.p[k] = p[k]; a.n[k] = n[k]; a.c[k] = p[k]; }
+        a.r_inner = w["outlet_radius"].get<double>();
+        if (w.contains("outlet_open_at")) {
+          const double t_open = w["outlet_open_at"].get<double>();
+          plane(name + ".plug", p, n);
+          out.back().remove_at = t_open;
+          a.active_from = t_open;
+        }
+        out.push_back(a);
+      } else {
+        plane(name + ".bottom", p, n);
+      }
     }
     if (w.value("closed_top", false)) {
       p[m.axis] = m.hi; n[m.axis] = -1.0;
       plane(name + ".top", p, n);
     }
+  } else if (type == "cone") {
+    WallPrimitive m;
+    m.shape = WallPrimitive::Shape::cone_inside;
+    m.name = name + ".mantle";
+    m.material = material;
+    m.axis = axis_index(member(w, "axis"));
+    for (int a = 0; a < 3; ++a) m.c[a] = w["center"][a].get<double>();
+    m.radius = w["radius_bottom"].get<double>();
+    m.radius_hi = w["radius_top"].get<double>();
+    m.lo = w["bottom"].get<double>();
+    m.hi = w["top"].get<double>();
+    out.push_back(m);
+    if (w.value("closed_bottom", false)) {
+      WallPrimitive d;
+      d.shape = WallPrimitive::Shape::annulus;
+      d.name = name + ".plug";
+      d.material = material;
+      for (int k = 0; k < 3; ++k) { d.p[k] = m.c[k]; d.c[k] = m.c[k]; d.n[k] = 0.0; }
+      d.p[m.axis] = m.lo;
+      d.c[m.axis] = m.lo;
+      d.n[m.axis] = 1.0;
+      d.r_inner = 0.0;
+      d.r_outer = m.radius;
+      if (w.contains("outlet_open_at")) d.remove_at = w["outlet_open_at"].get<double>();
+      out.push_back(d);
+    }
+  } else if (type == "disk") {
+    WallPrimitive d;
+    d.shape = WallPrimitive::Shape::annulus;
+    d.name = name;
+    d.material = material;
+    double len = 0;
+    for (int a = 0; a < 3; ++a) len += w["normal"][a].get<double>() * w["normal"][a].get<double>();
+    len = std::sqrt(len);
+    for (int a = 0; a < 3; ++a) {
+      d.p[a] = d.c[a] = w["center"][a].get<double>();
+      d.n[a] = w["normal"][a].get<double>() / len;
+    }
+    d.r_inner = w.value("inner_radius", 0.0);
+    d.r_outer = w["radius"].get<double>();
+    out.push_back(d);
+  } else {  // mesh
+    std::filesystem::path f = w["file"].get<std::string>();
+    if (f.is_relative()) f = dir / f;
+    double tr[3] = {0, 0, 0};
+    if (w.contains("translate"))
+      for (int a = 0; a < 3; ++a) tr[a] = w["translate"][a].get<double>();
+    auto mesh = std::make_shared<TriangleMesh>(load_stl_mesh(f, w.value("scale", 1.0), tr));
+    spdlog::info("wall '{}': {} triangles, {} vertices, {} edges from {} ({} corners welded{})", name,
+                 mesh->triangle_count(), mesh->vertex_count(), mesh->edge_count(), f.string(), mesh->welded,
+                 mesh->dropped_degenerate ? ", " + std::to_string(mesh->dropped_degenerate) + " degenerate triangles dropped"
+                                          : std::string());
+    WallPrimitive m;
+    m.shape = WallPrimitive::Shape::mesh;
+    m.name = name;
+    m.material = material;
+    m.verts = mesh->vertices;
+    triangle_bounds(*mesh, m.verts, m.tri_bounds);
+    m.mesh = std::move(mesh);
+    out.push_back(std::move(m));
   }
   return out;
 }
 
-std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material) {
-  std::vector<WallPrimitive> out = expand_wall_shape(w, material);
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material, const std::filesystem::path& dir) {
+  std::vector<WallPrimitive> out = expand_wall_shape(w, material, dir);
   if (w.contains("remove_at"))
-    for (auto& p : out) p.remove_at = w["remove_at"].get<double>();
+    for (auto& p : out) p.remove_at = std::min(p.remove_at, w["remove_at"].get<double>());
+  if (const json* mo = member(w, "motion")) {
+    const std::string type = w["type"].get<std::string>();
+    for (auto& p : out) {
+      p.moving = true;
+      for (int a = 0; a < 3; ++a) {
+        p.velocity[a] = mo->contains("velocity") ? (*mo)["velocity"][a].get<double>() : 0.0;
+        p.omega[a] = mo->contains("angular_velocity") ? (*mo)["angular_velocity"][a].get<double>() : 0.0;
+        // default origin: the wall's own centre or point (on its rotation axis), 0 for a mesh
+        p.origin[a] = mo->contains("origin") ? (*mo)["origin"][a].get<double>()
+                      : type == "plane"      ? w["point"][a].get<double>()
+                      : w.contains("center") ? w["center"][a].get<double>()
+                                             : 0.0;
+      }
+      p.motion_start = mo->value("start", 0.0);
+      if (mo->contains("end")) p.motion_end = (*mo)["end"].get<double>();
+    }
+  }
   return out;
 }
 
@@ -519,8 +715,12 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   }
   if (doc.contains("walls"))
     for (const auto& w : doc["walls"]) {
-      auto prims = expand_wall(w, mat_index.at(w["material"].get<std::string>()));
-      sim->walls.insert(sim->walls.end(), prims.begin(), prims.end());
+      try {
+        auto prims = expand_wall(w, mat_index.at(w["material"].get<std::string>()), file.parent_path());
+        sim->walls.insert(sim->walls.end(), prims.begin(), prims.end());
+      } catch (const MeshError& e) {  // the file changed since validation
+        ck.add("/walls", e.what());
+      }
     }
 
   const json& run = doc["run"];

@@ -51,6 +51,8 @@ void Subdomain::set_environment(const std::vector<Material>& materials,
     wall_pairs_.push_back(make_pair(own_material_, materials.at((*walls)[w].material), wall_pairs.at(w), true,
                                     coarse_grain_));
   wall_lists_.assign(walls->size(), WallNeighbors{});
+  walls_now_ = *walls;
+  any_moving_ = std::any_of(walls_now_.begin(), walls_now_.end(), [](const WallPrimitive& w) { return w.moving; });
   for (int a = 0; a < 3; ++a) gravity_[a] = gravity[a];
 }
 
@@ -149,6 +151,7 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
 void Subdomain::setup() {
   const uint32_t stride = pipeline_->history_stride();
   nlist_.configure(skin_, stride);
+  update_walls(time_);
   rebuild_lists();
   compute_forces();
 }
@@ -156,8 +159,35 @@ void Subdomain::setup() {
 void Subdomain::rebuild_lists() {
   nlist_.build(store_);
   far_active_ = false;
-  for (std::size_t w = 0; w < wall_lists_.size(); ++w)
-    if (time_ < (*walls_)[w].remove_at) wall_lists_[w].build(store_, (*walls_)[w], skin_, pipeline_->history_stride());
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
+    const WallPrimitive& wall = walls_now_[w];
+    wall_lists_[w].build(store_, wall, skin_, pipeline_->history_stride(), wall.active(time_));
+    wall_lists_[w].built_elapsed = wall.elapsed(wall_time_);
+  }
+}
+
+void Subdomain::update_walls(double t) {
+  wall_time_ = t;
+  const uint32_t stride = pipeline_->history_stride();
+  for (std::size_t w = 0; w < walls_now_.size(); ++w) {
+    WallPrimitive& wall = walls_now_[w];
+    WallNeighbors& list = wall_lists_[w];
+    if (wall.moving) wall.place((*walls_)[w], t);
+    const bool active = wall.active(time_);
+    if (active != list.built) {
+      // activation: a fresh list, contacts start with zero history;
+      // removal: contacts open for good
+      list.clear();
+      if (active) {
+        list.build(store_, wall, skin_, stride, true);
+        list.built_elapsed = wall.elapsed(t);
+      }
+    } else if (active && wall.moving &&
+               wall.displacement_bound(list.built_elapsed, wall.elapsed(t)) > 0.5 * skin_) {
+      list.build(store_, wall, skin_, stride, true);  // the wall moved: its candidates may have changed
+      list.built_elapsed = wall.elapsed(t);
+    }
+  }
 }
 
 namespace {
@@ -244,6 +274,7 @@ void Subdomain::step() {
              nlist_.x0(), nlist_.y0(), nlist_.z0(), nlist_.rebuild_displacement2(),
              nlist_.far_tier_displacement2(), tier[static_cast<std::size_t>(t)]);
   });
+  update_walls(time_ + dt);
   if (stale || std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) {
     rebuild_lists();
   } else if (std::any_of(tier.begin(), tier.end(), [](double f) { return f != 0.0; })) {
@@ -641,8 +672,8 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
 
 void Subdomain::prune_removed_walls() {
   for (std::size_t w = 0; w < wall_lists_.size(); ++w)
-    if (time_ >= (*walls_)[w].remove_at && !wall_lists_[w].particle.empty())  // removed: contacts open for good
-      wall_lists_[w] = WallNeighbors{};
+    if (!walls_now_[w].active(time_) && wall_lists_[w].built)  // removed: contacts open for good
+      wall_lists_[w].clear();
 }
 
 void Subdomain::wall_forces() {
@@ -666,8 +697,8 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
   double max_ratio = 0.0;
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     WallNeighbors& list = wall_lists_[w];
-    const WallPrimitive& wall = (*walls_)[w];
-    if (time_ >= wall.remove_at) continue;  // pruned by prune_removed_walls()
+    const WallPrimitive& wall = walls_now_[w];
+    if (!wall.active(time_)) continue;  // pruned by prune_removed_walls() / update_walls()
     const auto lo = std::lower_bound(list.particle.begin(), list.particle.end(), static_cast<uint32_t>(first));
     const auto hi = std::lower_bound(lo, list.particle.end(), static_cast<uint32_t>(std::min<std::size_t>(last, UINT32_MAX)));
     const std::size_t e_first = static_cast<std::size_t>(lo - list.particle.begin());
@@ -695,22 +726,20 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
       contacts += c;
       c = 0;
     };
-    for (std::size_t e = e_first; e < e_last; ++e) {
-      const uint32_t i = list.particle[e];
-      double d, nx, ny, nz;
-      const bool has = wall.gap(s.x[i], s.y[i], s.z[i], d, nx, ny, nz);
-      if (!has || d >= s.radius[i]) {
-        if (list.touching[e]) {
-          list.touching[e] = 0;
-          std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(e * stride), stride, 0.0);
-        }
-        continue;
-      }
+    // One contact into the batch: entry e of the list, particle i, centre
+    // distance d from the contact point, unit normal n (wall -> centre).
+    const bool moving = wall.moving;
+    auto push = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
       const double delta = s.radius[i] - d;
       const double ci = s.radius[i] - delta;
-      const double rx = s.vx[i] - ci * (s.wy[i] * nz - s.wz[i] * ny);
-      const double ry = s.vy[i] - ci * (s.wz[i] * nx - s.wx[i] * nz);
-      const double rz = s.vz[i] - ci * (s.wx[i] * ny - s.wy[i] * nx);
+      double rx = s.vx[i] - ci * (s.wy[i] * nz - s.wz[i] * ny);
+      double ry = s.vy[i] - ci * (s.wz[i] * nx - s.wx[i] * nz);
+      double rz = s.vz[i] - ci * (s.wx[i] * ny - s.wy[i] * nx);
+      if (moving) {  // relative to the wall's surface velocity at the contact point x_i - ci n
+        double ux, uy, uz;
+        wall.surface_velocity(wall_time_, s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
+        rx -= ux; ry -= uy; rz -= uz;
+      }
       const double vdotn = rx * nx + ry * ny + rz * nz;
       buf.overlap[c] = delta;
       buf.nx[c] = nx; buf.ny[c] = ny; buf.nz[c] = nz;
@@ -727,6 +756,59 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
       ts.ci[c] = ci;
       max_ratio = std::max(max_ratio, delta / (2.0 * s.radius[i]));
       if (++c == ContactPipeline::kBatchSize) flush();
+    };
+    if (wall.shape == WallPrimitive::Shape::mesh) {
+      // Per particle: the counted features of its candidate triangles
+      // (resolve_mesh_contacts). A contact that moves from one triangle to
+      // a neighbour (a sphere crossing a seam) keeps its history: a newly
+      // counted entry takes the history of an entry of the same particle
+      // that stopped counting this step.
+      for (std::size_t e = e_first; e < e_last;) {
+        const uint32_t i = list.particle[e];
+        std::size_t e_end = e + 1;
+        while (e_end < e_last && list.particle[e_end] == i) ++e_end;
+        const std::size_t count = e_end - e;
+        const double p[3] = {s.x[i], s.y[i], s.z[i]};
+        resolve_mesh_contacts(*wall.mesh, wall.verts.data(), p, s.radius[i], list.triangle.data() + e, count,
+                              ts.mesh, ts.mesh_out, wall.tri_bounds.empty() ? nullptr : wall.tri_bounds.data());
+        ts.counted.assign(count, 0);
+        for (const MeshContact& mc : ts.mesh_out) ts.counted[mc.slot] = 1;
+        std::size_t released = SIZE_MAX;
+        for (std::size_t k = 0; k < count; ++k) {
+          if (!list.touching[e + k] || ts.counted[k]) continue;
+          list.touching[e + k] = 0;
+          if (released == SIZE_MAX) released = e + k;
+          else std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>((e + k) * stride), stride, 0.0);
+        }
+        for (const MeshContact& mc : ts.mesh_out) {
+          const std::size_t entry = e + mc.slot;
+          if (!list.touching[entry] && released != SIZE_MAX) {
+            std::copy_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride,
+                        list.history.begin() + static_cast<std::ptrdiff_t>(entry * stride));
+            std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride, 0.0);
+            released = SIZE_MAX;
+          }
+          push(entry, i, mc.d, mc.n[0], mc.n[1], mc.n[2]);
+        }
+        if (released != SIZE_MAX)
+          std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride, 0.0);
+        e = e_end;
+      }
+      flush();
+      continue;
+    }
+    for (std::size_t e = e_first; e < e_last; ++e) {
+      const uint32_t i = list.particle[e];
+      double d, nx, ny, nz;
+      const bool has = wall.gap(s.x[i], s.y[i], s.z[i], d, nx, ny, nz);
+      if (!has || d >= s.radius[i]) {
+        if (list.touching[e]) {
+          list.touching[e] = 0;
+          std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(e * stride), stride, 0.0);
+        }
+        continue;
+      }
+      push(e, i, d, nx, ny, nz);
     }
     flush();
   }

@@ -112,6 +112,9 @@ class Subdomain {
     std::size_t lo = 0, hi = 0;      ///< particle-index span of this thread's pairs this step (threads > 0)
     std::size_t span[2][2] = {{0, 0}, {0, 0}};  ///< the span per list tier (near, far)
     double max_ratio = 0;
+    MeshScratch mesh;                ///< mesh walls: per-particle feature bookkeeping
+    std::vector<MeshContact> mesh_out;
+    std::vector<uint8_t> counted;
   };
   /// Where a thread adds forces: the store itself (thread 0) or its own arrays.
   struct Accumulator {
@@ -120,6 +123,9 @@ class Subdomain {
   };
 
   void rebuild_lists();
+  /// Move the moving walls to time t; rebuild the list of a wall that became
+  /// active or moved more than skin/2 since its build, clear a removed one's.
+  void update_walls(double t);
   void compute_forces();   ///< reset to gravity, then contact_forces()
   /// Add particle-pair and wall contact forces; with defer_reduce the other
   /// threads' partial sums are left for the caller (reduce_partials).
@@ -140,7 +146,10 @@ class Subdomain {
   ParticleStore store_;
   NeighborList nlist_;
   std::vector<WallNeighbors> wall_lists_;
-  const std::vector<WallPrimitive>* walls_ = nullptr;
+  const std::vector<WallPrimitive>* walls_ = nullptr;  ///< reference state (time 0) of the walls
+  std::vector<WallPrimitive> walls_now_;  ///< this subdomain's walls placed at wall_time_
+  bool any_moving_ = false;
+  double wall_time_ = 0;                  ///< time of the walls' placement and surface velocities
   std::vector<domel_pair_v1> wall_pairs_;
   domel_pair_v1 self_pair_{};
   Material own_material_;
