@@ -73,6 +73,27 @@ void NeighborList::build(const ParticleStore& s) {
       const double span = hi[a] - lo[a];
       dim[a] = std::max(1, std::min(1 << 20, static_cast<int>(span / cell)));
     }
+    // A few particles far from the rest (thrown out of a silo, say) would
+    // stretch the grid until the bound below merges everything into a few
+    // huge cells, and the build would go quadratic. Then span the grid over
+    // the central 99.8 % of the particles on each axis instead: cell_of()
+    // clamps the outliers into the edge cells, and clamping is monotone and
+    // never separates two particles by more than one cell, so no pair is lost.
+    if (static_cast<double>(dim[0]) * dim[1] * dim[2] > 8.0 * static_cast<double>(n) + 64 && n > 1000) {
+      std::vector<double> c(n);
+      const std::size_t k_lo = n / 1000, k_hi = n - 1 - n / 1000;
+      for (int a = 0; a < 3; ++a) {
+        const std::vector<double>& src = a == 0 ? s.x : a == 1 ? s.y : s.z;
+        std::copy(src.begin(), src.begin() + static_cast<std::ptrdiff_t>(n), c.begin());
+        std::nth_element(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(k_lo), c.end());
+        const double q_lo = c[k_lo];
+        std::nth_element(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(k_hi), c.end());
+        const double q_hi = c[k_hi];
+        lo[a] = std::max(lo[a], q_lo - cell);
+        hi[a] = std::min(hi[a], q_hi + cell);
+        dim[a] = std::max(1, std::min(1 << 20, static_cast<int>((hi[a] - lo[a]) / cell)));
+      }
+    }
     // Keep the cell count bounded for sparse systems (halving only widens cells).
     while (static_cast<double>(dim[0]) * dim[1] * dim[2] > 8.0 * static_cast<double>(n) + 64) {
       for (int a = 0; a < 3; ++a) dim[a] = std::max(1, dim[a] / 2);

@@ -197,7 +197,7 @@ struct WallPrimitive {
   }
 
   /// Flat annulus r_inner <= rho <= r_outer in the plane through p with
-  /// normal n: a face contact over the annulus (one-sided, like a plane),
+  /// normal n: a face contact over the annulus from either side (a thin plate),
   /// an edge contact with the nearest point of the inner rim inside the hole
   /// (from either side), no contact beyond the outer radius.
   bool annulus_gap(double x, double y, double z, double& d, double& nx, double& ny, double& nz) const {
@@ -207,8 +207,12 @@ struct WallPrimitive {
     const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
     if (rho > r_outer) return false;
     if (rho >= r_inner) {
-      d = h;
-      nx = n[0]; ny = n[1]; nz = n[2];
+      // Two-sided: a plate is thin, and a particle that left through the
+      // hole may drift under it (silo_ci found one: as one-sided face its
+      // "overlap" R - h exceeded R and the particle was shot away).
+      const double sgn = h >= 0 ? 1.0 : -1.0;
+      d = sgn * h;
+      nx = sgn * n[0]; ny = sgn * n[1]; nz = sgn * n[2];
       return true;
     }
     const double dr = rho - r_inner;  // < 0: the rim is farther out than the point

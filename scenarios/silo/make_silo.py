@@ -12,7 +12,8 @@ deletion region that counts the mass. Variants:
   silo_ci.json      D = 70 mm, outlet 20 mm (7.1 d), 15,000 particles, alpha = 1:
                     the CI-sized case with the Beverloo check.
 Each pours at a mass rate from a cylinder near the top (random sequential
-addition at volume fraction 0.3, 1.5 m/s downwards), opens the outlet once
+addition at volume fraction 0.22, 1.5 m/s downwards; RSA in a
+narrow cylinder jams well below its bulk limit of 0.38), opens the outlet once
 the bed has settled, and reports the steady discharge rate (least squares
 over rate_window) in summary.json; a cell grid gives the volume fraction and
 the pressure profile over height. Time step 1.8e-5 s: 21 steps per contact
@@ -28,12 +29,12 @@ M_P = RHO * math.pi / 6 * D_P ** 3
 VARIANTS = {
     # name: silo radius, outlet diameter, particles (alpha = 1 count), alpha, top, pour [z0, z1], rate kg/s,
     #       open time, end time, fit window start, grid cells (xy, z), vtk interval
-    "silo_fine": dict(R=0.075, Do=0.030, n=187504, alpha=1, top=0.32, pour=(0.25, 0.31), rate=12.0,
-                      t_open=0.9, t_end=2.4, fit0=1.2, cells=(5, 24), grid_top=0.24, vtk=0.1),
-    "silo_coarse": dict(R=0.075, Do=0.030, n=187504, alpha=2, top=0.32, pour=(0.25, 0.31), rate=12.0,
-                        t_open=0.9, t_end=2.4, fit0=1.2, cells=(5, 24), grid_top=0.24, vtk=0.1),
-    "silo_ci": dict(R=0.035, Do=0.020, n=15000, alpha=1, top=0.16, pour=(0.11, 0.15), rate=3.0,
-                    t_open=0.45, t_end=1.1, fit0=0.6, cells=(2, 8), grid_top=0.08, vtk=0.05),
+    "silo_fine": dict(R=0.075, Do=0.030, n=187504, alpha=1, top=0.33, pour=(0.26, 0.32), rate=10.0,
+                      t_open=1.0, t_end=2.5, fit0=1.3, cells=(5, 24), grid_top=0.24, vtk=0.1),
+    "silo_coarse": dict(R=0.075, Do=0.030, n=187504, alpha=2, top=0.33, pour=(0.26, 0.32), rate=10.0,
+                        t_open=1.0, t_end=2.5, fit0=1.3, cells=(5, 24), grid_top=0.24, vtk=0.1),
+    "silo_ci": dict(R=0.035, Do=0.020, n=15000, alpha=1, top=0.17, pour=(0.10, 0.16), rate=2.5,
+                    t_open=0.5, t_end=1.15, fit0=0.65, cells=(2, 8), grid_top=0.08, vtk=0.05),
 }
 
 
@@ -72,7 +73,7 @@ def scenario(name, R, Do, n, alpha, top, pour, rate, t_open, t_end, fit0, cells,
                         "tangential": {"model": "mindlin"}},
             "time_step": dt, "impact_velocity": 1.0,
             "pour": [{
-                "insert": {"model": "random", "diameter": D_P, "volume_fraction": 0.3,
+                "insert": {"model": "random", "diameter": D_P, "volume_fraction": 0.22,
                            "region": {"cylinder": {"axis": "z", "center": [0, 0, 0],
                                                    "radius": R - alpha * D_P, "bottom": pour[0], "top": pour[1]}},
                            "velocity": [0, 0, -1.5]},

@@ -53,6 +53,24 @@ TEST(NeighborList, FindsExactlyThePairsWithinCutoffOrientedByIds) {
   EXPECT_GT(found.size(), 100u);
 }
 
+TEST(NeighborList, FarOutliersLoseNoPairs) {
+  // A few particles thrown 100 m away (silo_ci once shot some out) make the
+  // build span its grid over the bulk and clamp the outliers into the edge
+  // cells (so it does not go quadratic): the list must still be exact, and
+  // the outliers that sit next to each other must still find each other.
+  ParticleStore s = cloud(3000, 11);
+  s.add(1, 100.0, 100.0, 100.0, 0.002, 2500);
+  s.add(2, 100.0, 100.0, 100.003, 0.002, 2500);
+  s.add(3, -50.0, 0.0, 0.0, 0.002, 2500);
+  NeighborList nl;
+  nl.configure(0.0008, 3);
+  nl.build(s);
+  std::set<std::pair<std::uint64_t, std::uint64_t>> found;
+  for (std::size_t k = 0; k < nl.size(); ++k) found.insert({s.id[nl.i[k]], s.id[nl.j[k]]});
+  EXPECT_EQ(found, brute(s, 0.0008));
+  EXPECT_TRUE(found.count({1, 2}));
+}
+
 TEST(NeighborList, CellsAreNeverNarrowerThanTheCutoff) {
   // regression: with floor(span/cutoff) + 1 cells per axis a cell was narrower
   // than the cutoff and this touching pair (2, 3), 0.9 apart, was missed
