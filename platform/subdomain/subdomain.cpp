@@ -157,6 +157,20 @@ void Subdomain::setup() {
 }
 
 void Subdomain::rebuild_lists() {
+  // Space-filling-curve re-ordering (docs/performance.md): particles that
+  // were inserted in random order (pours, random fills) or have mixed are put
+  // back in Morton order every kReorderEvery builds, so that the pair loop's
+  // partners sit close in memory. Small systems are left alone (their arrays
+  // fit the cache, and tests may address particles by index).
+  if (store_.size() >= kReorderMinParticles &&
+      (builds_since_reorder_ >= kReorderEvery || store_.size() > reordered_size_ + reordered_size_ / 10)) {
+    double rmax = 0.0;
+    for (double r : store_.radius) rmax = std::max(rmax, r);
+    store_.permute(store_.spatial_order(2.0 * rmax + skin_));
+    builds_since_reorder_ = 0;
+    reordered_size_ = store_.size();
+  }
+  ++builds_since_reorder_;
   nlist_.build(store_);
   far_active_ = false;
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {

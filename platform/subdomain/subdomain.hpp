@@ -166,7 +166,11 @@ class Subdomain {
   std::size_t split_builds_ = 0;
   bool reduce_pending_ = false;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
-  bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
+  static constexpr std::size_t kReorderMinParticles = 5000;
+  static constexpr std::size_t kReorderEvery = 20;  ///< list builds between Morton re-orderings
+  std::size_t builds_since_reorder_ = kReorderEvery;  ///< re-order at the first build
+  std::size_t reordered_size_ = 0;
+    bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::unique_ptr<ThreadPool> pool_;
 };
