@@ -47,19 +47,6 @@ std::size_t ParticleStore::remove_marked(const std::vector<std::uint8_t>& remove
   return n - kept;
 }
 
-namespace {
-/// Spread the low 21 bits of v so that two zero bits follow each (Morton code).
-std::uint64_t spread3(std::uint64_t v) {
-  v &= 0x1fffffu;
-  v = (v | v << 32) & 0x1f00000000ffffull;
-  v = (v | v << 16) & 0x1f0000ff0000ffull;
-  v = (v | v << 8) & 0x100f00f00f00f00full;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-  v = (v | v << 2) & 0x1249249249249249ull;
-  return v;
-}
-}  // namespace
-
 std::vector<std::uint32_t> ParticleStore::spatial_order(double cell) const {
   const std::size_t n = size();
   double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -68,13 +55,17 @@ std::vector<std::uint32_t> ParticleStore::spatial_order(double cell) const {
     lo[0] = std::min(lo[0], x[k]); lo[1] = std::min(lo[1], y[k]); lo[2] = std::min(lo[2], z[k]);
   }
   const double inv = cell > 0 ? 1.0 / cell : 0.0;
-  constexpr double kMaxCell = static_cast<double>((1u << 21) - 1);  // far outliers share the last cell
+  // Cell rows: z, then y, then x, 21 bits each (far outliers share the last
+  // cell). Measured against a Morton (Z-order) key: the same +30 % on a
+  // random fill, but -6 % instead of -2 % on S1's lattice, whose insertion
+  // order already is row-major (docs/performance.md).
+  constexpr double kMaxCell = static_cast<double>((1u << 21) - 1);
   std::vector<std::pair<std::uint64_t, std::uint32_t>> key(n);
   for (std::size_t k = 0; k < n; ++k) {
     const double p[3] = {x[k], y[k], z[k]};
     std::uint64_t c[3];
     for (int a = 0; a < 3; ++a) c[a] = static_cast<std::uint64_t>(std::min(kMaxCell, std::max(0.0, (p[a] - lo[a]) * inv)));
-    key[k] = {spread3(c[0]) | spread3(c[1]) << 1 | spread3(c[2]) << 2, static_cast<std::uint32_t>(k)};
+    key[k] = {(c[2] << 42) | (c[1] << 21) | c[0], static_cast<std::uint32_t>(k)};
   }
   std::sort(key.begin(), key.end());
   std::vector<std::uint32_t> order(n);

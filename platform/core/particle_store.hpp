@@ -51,10 +51,10 @@ struct ParticleStore {
   /// Apply a permutation: new index k holds old particle order[k].
   void permute(const std::vector<std::uint32_t>& order);
 
-  /// The order that sorts the particles along a Morton (Z-order) curve over
-  /// cubic cells of side `cell` (ties keep the current order): new index k
-  /// holds old particle order[k], for permute(). Particles close in space
-  /// end up close in memory, so the pair loop's gathers hit the cache.
+  /// The order that sorts the particles by cubic cells of side `cell`, cell
+  /// rows in z-y-x order (ties keep the current order): new index k holds
+  /// old particle order[k], for permute(). Particles close in space end up
+  /// close in memory, so the pair loop's gathers hit the cache.
   std::vector<std::uint32_t> spatial_order(double cell) const;
 
   /// Visit every per-particle array (for permutation, removal, resizing).

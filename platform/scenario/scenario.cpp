@@ -897,6 +897,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     for (double r : sub->store().radius) rmax = std::max(rmax, r);
     for (double r : pour_radii) rmax = std::max(rmax, r);
     sub->set_skin(sd.value("skin", 0.5) * 2.0 * (rmax > 0 ? rmax : 1e-3));
+    sub->set_reorder_every(sd.value("reorder_every", static_cast<std::size_t>(20)));
 
     // time step
     const double v_imp = sd.value("impact_velocity", 1.0);

@@ -157,13 +157,13 @@ void Subdomain::setup() {
 }
 
 void Subdomain::rebuild_lists() {
-  // Space-filling-curve re-ordering (docs/performance.md): particles that
+  // Spatial re-ordering (docs/performance.md): particles that
   // were inserted in random order (pours, random fills) or have mixed are put
-  // back in Morton order every kReorderEvery builds, so that the pair loop's
+  // back in cell order every reorder_every_ builds, so that the pair loop's
   // partners sit close in memory. Small systems are left alone (their arrays
   // fit the cache, and tests may address particles by index).
-  if (store_.size() >= kReorderMinParticles &&
-      (builds_since_reorder_ >= kReorderEvery || store_.size() > reordered_size_ + reordered_size_ / 10)) {
+  if (reorder_every_ > 0 && store_.size() >= kReorderMinParticles &&
+      (builds_since_reorder_ >= reorder_every_ || store_.size() > reordered_size_ + reordered_size_ / 10)) {
     double rmax = 0.0;
     for (double r : store_.radius) rmax = std::max(rmax, r);
     store_.permute(store_.spatial_order(2.0 * rmax + skin_));

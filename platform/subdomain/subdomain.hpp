@@ -17,6 +17,7 @@
 #include "geometry/wall.hpp"
 #include "geometry/wall_neighbors.hpp"
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -66,6 +67,9 @@ class Subdomain {
                        const PairCoefficients& self_pair, const std::vector<WallPrimitive>* walls,
                        const double gravity[3]);
   void set_skin(double skin) { skin_ = skin; }
+  /// Re-order the store by spatial cells every `builds` neighbour-list
+  /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
+  void set_reorder_every(std::size_t builds) { reorder_every_ = builds; }
   double skin() const { return skin_; }
   void set_time_step(double dt) { dt_ = dt; }
   /// Worker threads for the force and integration loops (>= 1). Results are
@@ -167,8 +171,8 @@ class Subdomain {
   bool reduce_pending_ = false;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   static constexpr std::size_t kReorderMinParticles = 5000;
-  static constexpr std::size_t kReorderEvery = 20;  ///< list builds between Morton re-orderings
-  std::size_t builds_since_reorder_ = kReorderEvery;  ///< re-order at the first build
+  std::size_t reorder_every_ = 20;  ///< list builds between spatial re-orderings (0: never)
+  std::size_t builds_since_reorder_ = SIZE_MAX / 2;  ///< re-order at the first build
   std::size_t reordered_size_ = 0;
     bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
