@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // CellGridVtkSeries builds a vtkImageData whose cells are the grid's cells
 // (VTK orders cell data x fastest, then y, then z, the same flattening as
-// CellFields), writes it with vtkXMLImageDataWriter under a temporary name and
-// renames it into place, then regenerates the .pvd text and writes it with
-// write_file_atomically(). CellGridProfileCsv appends the layer profile rows
+// CellFields) and writes it as the next frame of a VtkFrames series
+// (vtkXMLImageDataWriter; temporary name then rename; .pvd rewritten).
+// CellGridProfileCsv appends the layer profile rows
 // to a CsvSeries and flushes it.
 #include "io/cell_grid_output.hpp"
 
@@ -31,30 +31,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The two helpers below repeat those of io/vtk_writer.cpp (kept private
-// there); if a third writer needs them they belong in a shared header.
-
-/// Shortest text that reads back as the same double (locale independent).
-std::string format_double(double v) {
-  char buf[64];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
-
-/// Escape the characters that may not appear verbatim in an XML attribute.
-std::string xml_attribute(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 /// A cell-data array of `comps` components copied from `values`.
 void add_array(vtkCellData* cd, const char* name, const std::vector<double>& values, int comps,
@@ -81,7 +57,7 @@ void ensure_directory(const fs::path& dir) {
 }  // namespace
 
 CellGridVtkSeries::CellGridVtkSeries(fs::path directory, std::string basename)
-    : directory_(std::move(directory)), basename_(std::move(basename)) {
+    : directory_(directory), basename_(basename), frames_(std::move(directory), std::move(basename), "vti") {
   if (basename_.empty() || basename_.find('/') != std::string::npos) {
     throw std::invalid_argument("CellGridVtkSeries: basename must be a non-empty file name, got '" +
                                 basename_ + "'");
@@ -127,48 +103,9 @@ fs::path CellGridVtkSeries::write(double time, const CellGrid& grid, const CellF
   image->GetFieldData()->AddArray(samples);
 
   ensure_directory(directory_);
-  char index[32];
-  std::snprintf(index, sizeof index, "%06zu", frames_.size());
-  const std::string file = basename_ + "_" + index + ".vti";
-  const fs::path target = directory_ / file;
-  fs::path tmp = target;
-  tmp += ".tmp-" + std::to_string(static_cast<long long>(::getpid()));
-
-  std::error_code ec;
   vtkNew<vtkXMLImageDataWriter> writer;
   writer->SetInputData(image);
-  writer->SetFileName(tmp.c_str());
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();
-  writer->SetCompressorTypeToZLib();
-  writer->SetHeaderTypeToUInt64();
-  const int ok = writer->Write();
-  if (ok != 1 || writer->GetErrorCode() != 0) {
-    fs::remove(tmp, ec);
-    throw RuntimeError("cannot write file '" + target.string() + "': vtkXMLImageDataWriter failed");
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    fs::remove(tmp, ec);
-    throw RuntimeError("cannot write file '" + target.string() + "': cannot rename '" + tmp.string() +
-                       "' onto it: " + why);
-  }
-  frames_.push_back(Frame{time, file});
-
-  std::string xml =
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"Collection\" version=\"0.1\">\n"
-      "  <Collection>\n";
-  for (const Frame& fr : frames_) {
-    xml += "    <DataSet timestep=\"" + format_double(fr.time) + "\" group=\"\" part=\"0\" file=\"" +
-           xml_attribute(fr.file) + "\"/>\n";
-  }
-  xml +=
-      "  </Collection>\n"
-      "</VTKFile>\n";
-  write_file_atomically(directory_ / (basename_ + ".pvd"), xml);
-  return target;
+  return frames_.write(*writer, time);
 }
 
 namespace {

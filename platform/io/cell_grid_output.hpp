@@ -7,6 +7,8 @@
 // (io/vtk_writer.hpp), so both can be opened while the run goes on.
 #pragma once
 
+#include "io/vtk_frames.hpp"
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -38,13 +40,9 @@ class CellGridVtkSeries {
   std::size_t files_written() const { return frames_.size(); }
 
  private:
-  struct Frame {
-    double time;
-    std::string file;  ///< relative to directory_
-  };
   std::filesystem::path directory_;
   std::string basename_;
-  std::vector<Frame> frames_;
+  VtkFrames frames_;
 };
 
 /// The layer profile as a CSV time series, <dir>/<name>_profile.csv, columns

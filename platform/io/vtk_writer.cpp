@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: MIT
-// VtkSeriesWriter: builds a vtkPolyData of vertices from the particle stores,
-// writes it with vtkXMLPolyDataWriter (appended raw binary, zlib) under a
-// temporary name and renames it into place, then regenerates the .pvd
-// collection text and writes it with write_file_atomically().
+// VtkSeriesWriter: builds a vtkPolyData of vertices from the particle stores
+// and writes it as the next frame of a VtkFrames series (vtkXMLPolyDataWriter,
+// appended raw binary, zlib; temporary name then rename; .pvd rewritten).
 #include "io/vtk_writer.hpp"
 
 #include <algorithm>
@@ -35,29 +34,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Shortest text that reads back as the same double (locale independent).
-std::string format_double(double v) {
-  char buf[64];
-  const auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
-
-/// Escape the characters that may not appear verbatim in an XML attribute.
-std::string xml_attribute(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 void check_store(const ParticleSet& set) {
   if (set.store == nullptr) {
     throw std::invalid_argument("VtkSeriesWriter::write: null particle store for subdomain " +
@@ -86,7 +62,7 @@ vtkNew<vtkDoubleArray> vector_array(const char* name, vtkIdType n) {
 }  // namespace
 
 VtkSeriesWriter::VtkSeriesWriter(fs::path directory, std::string basename)
-    : directory_(std::move(directory)), basename_(std::move(basename)) {
+    : directory_(directory), basename_(basename), frames_(std::move(directory), std::move(basename), "vtp") {
   if (basename_.empty() || basename_.find('/') != std::string::npos) {
     throw std::invalid_argument("VtkSeriesWriter: basename must be a non-empty file name, got '" +
                                 basename_ + "'");
@@ -168,51 +144,9 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
                        "': " + ec.message());
   }
 
-  char index[32];
-  std::snprintf(index, sizeof index, "%06zu", frames_.size());
-  const std::string file = basename_ + "_" + index + ".vtp";
-  const fs::path target = directory_ / file;
-  fs::path tmp = target;
-  tmp += ".tmp-" + std::to_string(static_cast<long long>(::getpid()));
-
   vtkNew<vtkXMLPolyDataWriter> writer;
   writer->SetInputData(poly);
-  writer->SetFileName(tmp.c_str());
-  writer->SetDataModeToAppended();
-  writer->EncodeAppendedDataOff();  // raw binary, not base64
-  writer->SetCompressorTypeToZLib();
-  writer->SetHeaderTypeToUInt64();
-  const int ok = writer->Write();
-  if (ok != 1 || writer->GetErrorCode() != 0) {
-    fs::remove(tmp, ec);
-    throw RuntimeError("cannot write file '" + target.string() + "': vtkXMLPolyDataWriter failed");
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    fs::remove(tmp, ec);
-    throw RuntimeError("cannot write file '" + target.string() + "': cannot rename '" +
-                       tmp.string() + "' onto it: " + why);
-  }
-
-  frames_.push_back(Frame{time, file});
-  write_collection();
-  return target;
-}
-
-void VtkSeriesWriter::write_collection() const {
-  std::string xml =
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"Collection\" version=\"0.1\">\n"
-      "  <Collection>\n";
-  for (const Frame& f : frames_) {
-    xml += "    <DataSet timestep=\"" + format_double(f.time) + "\" group=\"\" part=\"0\" file=\"" +
-           xml_attribute(f.file) + "\"/>\n";
-  }
-  xml +=
-      "  </Collection>\n"
-      "</VTKFile>\n";
-  write_file_atomically(directory_ / (basename_ + ".pvd"), xml);
+  return frames_.write(*writer, time);
 }
 
 }  // namespace domel::platform::io

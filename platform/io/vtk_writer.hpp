@@ -7,6 +7,8 @@
 // replaced atomically, so the series can be opened while the run goes on.
 #pragma once
 
+#include "io/vtk_frames.hpp"
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -53,16 +55,9 @@ class VtkSeriesWriter {
   std::size_t files_written() const { return frames_.size(); }
 
  private:
-  struct Frame {
-    double time;
-    std::string file;  ///< relative to directory_
-  };
-
-  void write_collection() const;
-
   std::filesystem::path directory_;
   std::string basename_;
-  std::vector<Frame> frames_;
+  VtkFrames frames_;
 };
 
 }  // namespace domel::platform::io

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: MIT
+// ParaView frame series and .pvd collection (see vtk_frames.hpp).
+#include "io/vtk_frames.hpp"
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+#include <vtkXMLWriter.h>
+
+#include <unistd.h>
+
+#include <charconv>
+#include <cstdio>
+#include <system_error>
+
+namespace domel::platform::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Shortest text that reads back as the same double (locale independent).
+std::string format_double(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+/// Escape the characters that may not appear verbatim in an XML attribute.
+std::string xml_attribute(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+VtkFrames::VtkFrames(fs::path directory, std::string basename, std::string extension)
+    : directory_(std::move(directory)), basename_(std::move(basename)), extension_(std::move(extension)) {}
+
+fs::path VtkFrames::write(vtkXMLWriter& writer, double time) {
+  std::error_code ec;
+  char index[32];
+  std::snprintf(index, sizeof index, "%06zu", frames_.size());
+  const std::string file = basename_ + "_" + index + "." + extension_;
+  const fs::path target = directory_ / file;
+  fs::path tmp = target;
+  tmp += ".tmp-" + std::to_string(static_cast<long long>(::getpid()));
+
+  writer.SetFileName(tmp.c_str());
+  writer.SetDataModeToAppended();
+  writer.EncodeAppendedDataOff();  // raw binary, not base64
+  writer.SetCompressorTypeToZLib();
+  writer.SetHeaderTypeToUInt64();
+  const int ok = writer.Write();
+  if (ok != 1 || writer.GetErrorCode() != 0) {
+    fs::remove(tmp, ec);
+    throw RuntimeError("cannot write file '" + target.string() + "': " + writer.GetClassName() + " failed");
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    fs::remove(tmp, ec);
+    throw RuntimeError("cannot write file '" + target.string() + "': cannot rename '" + tmp.string() +
+                       "' onto it: " + why);
+  }
+  frames_.push_back(Frame{time, file});
+  write_collection();
+  return target;
+}
+
+void VtkFrames::write_collection() const {
+  std::string xml =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"Collection\" version=\"0.1\">\n"
+      "  <Collection>\n";
+  for (const Frame& f : frames_)
+    xml += "    <DataSet timestep=\"" + format_double(f.time) + "\" group=\"\" part=\"0\" file=\"" +
+           xml_attribute(f.file) + "\"/>\n";
+  xml +=
+      "  </Collection>\n"
+      "</VTKFile>\n";
+  write_file_atomically(directory_ / (basename_ + ".pvd"), xml);
+}
+
+}  // namespace domel::platform::io
