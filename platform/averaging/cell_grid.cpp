@@ -90,7 +90,7 @@ std::ptrdiff_t CellGrid::cell_of(double x, double y, double z) const {
 void CellGrid::set_accessible(const std::vector<WallPrimitive>& walls, double time) {
   std::vector<const WallPrimitive*> active;
   for (const WallPrimitive& w : walls) {
-    if (w.remove_at > time) active.push_back(&w);
+    if (w.active(time)) active.push_back(&w);
   }
   const int n = spec_.accessible_samples;
   const double inv_points = 1.0 / (static_cast<double>(n) * n * n);

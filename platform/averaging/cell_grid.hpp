@@ -120,7 +120,7 @@ class CellGrid {
   /// the particle side of every wall, by regular sub-sampling
   /// (accessible_samples^3 points at the sub-cell centres; a point is
   /// accessible when every primitive whose gap() is defined there gives
-  /// d >= 0). Walls with remove_at <= `time` are ignored. Sampling error
+  /// d >= 0). Only walls active at `time` count (WallPrimitive::active). Sampling error
   /// with n points per axis: at most 1/(2n) of the cell for a plane parallel
   /// to a cell face; for curved or oblique walls of that order or less
   /// (0.019 measured for a cylinder at n = 8, docs/averaging.md).

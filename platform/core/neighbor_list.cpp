@@ -71,7 +71,7 @@ void NeighborList::build(const ParticleStore& s) {
     int dim[3];
     for (int a = 0; a < 3; ++a) {
       const double span = hi[a] - lo[a];
-      dim[a] = std::max(1, std::min(1 << 20, static_cast<int>(span / cell)));
+      dim[a] = static_cast<int>(std::max(1.0, std::min(static_cast<double>(1 << 20), span / cell)));
     }
     // A few particles far from the rest (thrown out of a silo, say) would
     // stretch the grid until the bound below merges everything into a few
@@ -91,7 +91,7 @@ void NeighborList::build(const ParticleStore& s) {
         const double q_hi = c[k_hi];
         lo[a] = std::max(lo[a], q_lo - cell);
         hi[a] = std::min(hi[a], q_hi + cell);
-        dim[a] = std::max(1, std::min(1 << 20, static_cast<int>((hi[a] - lo[a]) / cell)));
+        dim[a] = static_cast<int>(std::max(1.0, std::min(static_cast<double>(1 << 20), (hi[a] - lo[a]) / cell)));
       }
     }
     // Keep the cell count bounded for sparse systems (halving only widens cells).
@@ -102,7 +102,9 @@ void NeighborList::build(const ParticleStore& s) {
     for (int a = 0; a < 3; ++a) inv[a] = dim[a] / std::max(hi[a] - lo[a], 1e-300) * (1.0 - 1e-12);
     auto cell_of = [&](std::size_t k, int* c) {
       const double p[3] = {s.x[k], s.y[k], s.z[k]};
-      for (int a = 0; a < 3; ++a) c[a] = std::min(dim[a] - 1, std::max(0, static_cast<int>((p[a] - lo[a]) * inv[a])));
+      // clamp in double first: an outlier far outside [lo, hi] must not overflow the int cast
+      for (int a = 0; a < 3; ++a)
+        c[a] = static_cast<int>(std::min(static_cast<double>(dim[a] - 1), std::max(0.0, (p[a] - lo[a]) * inv[a])));
     };
     const std::size_t ncell = static_cast<std::size_t>(dim[0]) * dim[1] * dim[2];
     std::vector<uint32_t> start(ncell + 1, 0), order(n), cell_index(n);

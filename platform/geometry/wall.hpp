@@ -199,13 +199,23 @@ struct WallPrimitive {
   /// Flat annulus r_inner <= rho <= r_outer in the plane through p with
   /// normal n: a face contact over the annulus from either side (a thin plate),
   /// an edge contact with the nearest point of the inner rim inside the hole
-  /// (from either side), no contact beyond the outer radius.
+  /// and of the outer rim beyond the outer radius (from either side).
   bool annulus_gap(double x, double y, double z, double& d, double& nx, double& ny, double& nz) const {
     const double q[3] = {x - p[0], y - p[1], z - p[2]};
     const double h = q[0] * n[0] + q[1] * n[1] + q[2] * n[2];
     const double r[3] = {q[0] - h * n[0], q[1] - h * n[1], q[2] - h * n[2]};
     const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    if (rho > r_outer) return false;
+    if (rho > r_outer) {
+      // Beyond the outer radius: the outer rim edge (the mirror of the hole's
+      // rim below), so that a particle sliding in over the edge meets a
+      // contact that grows from zero instead of a face overlap of up to R.
+      const double dr = rho - r_outer;  // > 0
+      d = std::sqrt(dr * dr + h * h);
+      if (d <= 0.0) return false;
+      const double a = dr / (d * rho), b = h / d;
+      nx = a * r[0] + b * n[0]; ny = a * r[1] + b * n[1]; nz = a * r[2] + b * n[2];
+      return true;
+    }
     if (rho >= r_inner) {
       // Two-sided: a plate is thin, and a particle that left through the
       // hole may drift under it (silo_ci found one: as one-sided face its
@@ -244,7 +254,6 @@ struct WallPrimitive {
         const double r[3] = {q[0] - h * n[0], q[1] - h * n[1], q[2] - h * n[2]};
         const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
         if (rho > r_outer + reach) return false;
-        if (rho > r_outer) return h < reach;
         return gap(x, y, z, d, nx, ny, nz) && d < reach;
       }
       case Shape::cone_inside:

@@ -14,7 +14,14 @@
 
 namespace domel::platform {
 
-MassUnits mass_units(double kg) { return static_cast<MassUnits>(std::llround(kg * 1e18)); }
+MassUnits mass_units(double kg) {
+  // whole kilograms and the rest apart, so that no llround overflows (a single
+  // llround of kg * 1e18 would above 9.2 kg); the same double always gives
+  // the same units, which is all the exact balance needs
+  const double whole = std::floor(kg);
+  return static_cast<MassUnits>(static_cast<long long>(whole)) * static_cast<MassUnits>(1000000000000000000LL) +
+         static_cast<MassUnits>(std::llround((kg - whole) * 1e18));
+}
 
 double mass_kg(MassUnits u) {
   // exact enough for printing: split into a high and a low part so that the
@@ -66,7 +73,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   // Cumulative target: each event inserts the mass of the interval it opens,
   // so the mean rate is exact and a shortfall (a full region) is made up later.
   const double elapsed = std::min(t, p.end) - p.start;
-  const double target = std::min(p.total_mass, p.mass_rate * (elapsed + p.interval));
+  const double target = std::min(p.total_mass, p.mass_rate * std::min(elapsed + p.interval, p.end - p.start));
   ++p.events;
   if (p.inserted_mass >= target) return;
   ParticleStore& st = sd.store();

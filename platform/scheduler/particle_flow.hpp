@@ -30,7 +30,7 @@
 
 namespace domel::platform {
 
-/// Exact mass in units of 1e-18 kg (a particle of up to ~9 kg; sums in 128 bits).
+/// Exact mass in units of 1e-18 kg (sums in 128 bits).
 using MassUnits = __int128;
 MassUnits mass_units(double kg);
 double mass_kg(MassUnits u);

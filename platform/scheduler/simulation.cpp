@@ -108,6 +108,20 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       if (grid_setups[g].subdomain == k && grids[g]->due(sd.steps())) grids[g]->sample(sd.store(), records, sd.time());
     sd.set_record_contacts(false);
   };
+  // Walls that appear or disappear (an outlet plug) change the accessible
+  // volume: recompute it when the set of active walls changes.
+  std::vector<char> wall_active;
+  for (const auto& w : walls) wall_active.push_back(w.active(0.0) ? 1 : 0);
+  auto refresh_accessible = [&](double t) {
+    bool changed = false;
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      const char now = walls[w].active(t) ? 1 : 0;
+      changed = changed || now != wall_active[w];
+      wall_active[w] = now;
+    }
+    if (changed)
+      for (auto& g : grids) g->set_accessible(walls, t);
+  };
   auto write_grids = [&](double t, bool final) {
     for (std::size_t g = 0; g < grids.size(); ++g) {
       if (!grid_vtk[g] || (!final && t < grid_next_write[g] - 1e-9 * macro)) continue;
@@ -172,7 +186,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       write_vtk(t);
       next_vtk += vtk_interval;
     }
-    if (!grids.empty() && m > 0) write_grids(t, false);
+    if (!grids.empty() && m > 0) {
+      write_grids(t, false);
+      refresh_accessible(t);
+    }
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < subdomains.size(); ++k) {

@@ -198,8 +198,13 @@ void Subdomain::update_walls(double t) {
       }
     } else if (active && wall.moving &&
                wall.displacement_bound(list.built_elapsed, wall.elapsed(t)) > 0.5 * skin_) {
-      list.build(store_, wall, skin_, stride, true);  // the wall moved: its candidates may have changed
-      list.built_elapsed = wall.elapsed(t);
+      // The wall moved half the skin since its list was built. Rebuilding this
+      // list alone would not do: a particle may by now have moved up to half
+      // the skin from where the last full build saw it, and may move another
+      // half before the next, so wall and particle could close more than the
+      // skin. A full build resets both references (particle <= skin/2 + wall
+      // <= skin/2 until the next one).
+      walls_force_rebuild_ = true;
     }
   }
 }
@@ -289,7 +294,9 @@ void Subdomain::step() {
              nlist_.far_tier_displacement2(), tier[static_cast<std::size_t>(t)]);
   });
   update_walls(time_ + dt);
-  if (stale || std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) {
+  if (stale || walls_force_rebuild_ ||
+      std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) {
+    walls_force_rebuild_ = false;
     rebuild_lists();
   } else if (std::any_of(tier.begin(), tier.end(), [](double f) { return f != 0.0; })) {
     far_active_ = true;  // latched until the next build: far entries are screened from now on

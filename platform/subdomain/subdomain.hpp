@@ -174,7 +174,8 @@ class Subdomain {
   std::size_t reorder_every_ = 20;  ///< list builds between spatial re-orderings (0: never)
   std::size_t builds_since_reorder_ = SIZE_MAX / 2;  ///< re-order at the first build
   std::size_t reordered_size_ = 0;
-    bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
+    bool walls_force_rebuild_ = false;  ///< a moving wall travelled skin/2 since its list was built
+  bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::unique_ptr<ThreadPool> pool_;
 };

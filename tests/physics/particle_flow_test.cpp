@@ -29,7 +29,7 @@ namespace {
 using domel::platform::mass_kg;
 using nlohmann::json;
 
-json pour_box(double total_mass) {
+json pour_box(double total_mass, double end = 0.0) {
   json doc = domel::test::scenario(domel::test::hertz_mindlin(), 1e-5, 0.5, 0.5, 1e7);
   doc["gravity"] = {0, 0, -9.81};
   doc["walls"].push_back({{"name", "bin"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}},
@@ -44,6 +44,7 @@ json pour_box(double total_mass) {
                  {"velocity", {0, 0, -1}}};
   insert["region"]["box"] = {{"min", {0.001, 0.001, 0.1}}, {"max", {0.039, 0.039, 0.15}}};
   json pour = {{"mass_rate", 0.5}, {"interval", 0.05}, {"total_mass", total_mass}};
+  if (end > 0) pour["end"] = end;
   pour["insert"] = insert;
   doc["subdomains"][0]["pour"] = json::array({pour});
   doc["run"] = {{"duration", 0.5}};
@@ -80,6 +81,30 @@ TEST(ParticleFlow, PourFollowsTheMassRateWithoutOverlapAndTheBalanceIsExact) {
     flow.update(sd.time() - 1e-3, sim->subdomains);  // not due: nothing happens
     EXPECT_EQ(s.size(), n);
   }
+}
+
+TEST(ParticleFlow, PourStopsAtItsEndTime) {
+  // end = 0.12 s with events at 0, 0.05, 0.1 s: the last event's target is
+  // mass_rate x (end - start) = 0.06 kg, not mass_rate x (0.1 + interval).
+  auto sim = domel::test::build(pour_box(1.0, 0.12));
+  auto& sd = *sim->subdomains[0];
+  sim->flow.start(sim->subdomains);
+  sd.setup();
+  while (sd.time() < 0.2) {
+    sim->flow.update(sd.time(), sim->subdomains);
+    sd.step();
+  }
+  const double m_max = 2500.0 * M_PI / 6.0 * std::pow(0.005, 3);
+  EXPECT_EQ(sim->flow.pours[0].events, 3u);
+  EXPECT_GE(sim->flow.pours[0].inserted_mass, 0.06);
+  EXPECT_LT(sim->flow.pours[0].inserted_mass, 0.06 + m_max);
+}
+
+TEST(ParticleFlow, MassUnitsAreExactAndDoNotOverflowForHeavyParcels) {
+  using domel::platform::mass_units;
+  EXPECT_TRUE(mass_units(20.0) == static_cast<domel::platform::MassUnits>(20) * 1000000000000000000LL);
+  EXPECT_NEAR(mass_kg(mass_units(123.456789)), 123.456789, 1e-12);
+  EXPECT_TRUE(mass_units(3e-5) == static_cast<domel::platform::MassUnits>(30000000000000LL));
 }
 
 TEST(ParticleFlow, DeletionRegionAndPlaneCountTheSameMassAndTheBalanceStaysExact) {

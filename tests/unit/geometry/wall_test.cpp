@@ -30,7 +30,12 @@ TEST(AnnulusWall, FaceRimAndOuterEdge) {
   EXPECT_NEAR(d, 0.05, 1e-15);
   EXPECT_NEAR(ny, -0.6, 1e-14);
   EXPECT_NEAR(nz, -0.8, 1e-14);
-  EXPECT_FALSE(a.gap(0.51, 0.0, 1.01, d, nx, ny, nz));  // beyond the outer radius
+  // beyond the outer radius: the outer rim edge, distance sqrt(0.01^2 + 0.01^2), normal (1, 0, 1)/sqrt 2
+  ASSERT_TRUE(a.gap(0.51, 0.0, 1.01, d, nx, ny, nz));
+  EXPECT_NEAR(d, std::sqrt(2e-4), 1e-12);
+  EXPECT_NEAR(nx, std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(ny, 0.0, 1e-12);
+  EXPECT_NEAR(nz, std::sqrt(0.5), 1e-12);
   EXPECT_TRUE(a.near(0.51, 0.0, 1.01, 0.02));            // but a list candidate
 }
 
