@@ -27,7 +27,7 @@ bool NeighborList::needs_rebuild(const ParticleStore& s) const {
   return false;
 }
 
-void NeighborList::build(const ParticleStore& s) {
+void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   const std::size_t n = s.size();
   // Keep only the live history (pairs in contact, ~1-2 per particle), keyed by
   // (id_i, id_j), and release the old list before the new one is built: the
@@ -52,7 +52,11 @@ void NeighborList::build(const ParticleStore& s) {
   // Tiers (see near_size()): near entries go to i/j, far ones to fi/fj, each in
   // build order; far is appended after the cell loop.
   const double h = near_gap();
-  std::vector<uint32_t> fi, fj;
+  struct Part {
+    std::vector<uint32_t> i, j, fi, fj;
+  };
+  const int nt = pool != nullptr && n >= 4096 ? pool->size() : 1;
+  std::vector<Part> parts(static_cast<std::size_t>(nt));
 
   if (n > 0) {
     double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -119,11 +123,16 @@ void NeighborList::build(const ParticleStore& s) {
       std::vector<uint32_t> fill(start.begin(), start.end() - 1);
       for (std::size_t k = 0; k < n; ++k) order[fill[cell_index[k]]++] = static_cast<uint32_t>(k);
     }
+    // The scan over particles a, in contiguous ranges, one per thread: each
+    // range appends to its own near and far arrays, and the ranges are joined
+    // in order, so the list is exactly the one-thread list for any thread
+    // count (entries in order of a, then of the cell scan).
     // size from the last build (+5 %) rather than growing by doubling
-    const std::size_t expect = previous > 0 ? previous + previous / 20 : 4 * n;
-    i.reserve(expect);
-    j.reserve(expect);
-    for (std::size_t a = 0; a < n; ++a) {
+    const std::size_t expect = (previous > 0 ? previous + previous / 20 : 4 * n) / static_cast<std::size_t>(nt);
+    auto scan = [&](std::size_t a_first, std::size_t a_last, Part& part) {
+    part.i.reserve(expect);
+    part.j.reserve(expect);
+    for (std::size_t a = a_first; a < a_last; ++a) {
       int c[3];
       cell_of(a, c);
       for (int dz = -1; dz <= 1; ++dz) {
@@ -145,8 +154,8 @@ void NeighborList::build(const ParticleStore& s) {
               const double d2 = ddx * ddx + ddy * ddy + ddz * ddz;
               if (d2 < cut * cut) {
                 const bool near = std::sqrt(d2) - s.radius[a] - s.radius[b] < h;
-                auto& ti = near ? i : fi;
-                auto& tj = near ? j : fj;
+                auto& ti = near ? part.i : part.fi;
+                auto& tj = near ? part.j : part.fj;
                 if (s.id[a] < s.id[b]) { ti.push_back(static_cast<uint32_t>(a)); tj.push_back(b); }
                 else { ti.push_back(b); tj.push_back(static_cast<uint32_t>(a)); }
               }
@@ -155,22 +164,50 @@ void NeighborList::build(const ParticleStore& s) {
         }
       }
     }
+    };
+    if (nt == 1) {
+      scan(0, n, parts[0]);
+    } else {
+      pool->for_range(n, [&](std::size_t first, std::size_t last, int t) {
+        scan(first, last, parts[static_cast<std::size_t>(t)]);
+      });
+    }
   }
-  near_size_ = i.size();
-  i.insert(i.end(), fi.begin(), fi.end());
-  j.insert(j.end(), fj.begin(), fj.end());
-  std::vector<uint32_t>().swap(fi);
-  std::vector<uint32_t>().swap(fj);
+  std::size_t near_total = 0, total = 0;
+  for (const Part& p : parts) {
+    near_total += p.i.size();
+    total += p.i.size() + p.fi.size();
+  }
+  i.reserve(total);
+  j.reserve(total);
+  for (Part& p : parts) {
+    i.insert(i.end(), p.i.begin(), p.i.end());
+    j.insert(j.end(), p.j.begin(), p.j.end());
+    std::vector<uint32_t>().swap(p.i);
+    std::vector<uint32_t>().swap(p.j);
+  }
+  near_size_ = near_total;
+  for (Part& p : parts) {
+    i.insert(i.end(), p.fi.begin(), p.fi.end());
+    j.insert(j.end(), p.fj.begin(), p.fj.end());
+    std::vector<uint32_t>().swap(p.fi);
+    std::vector<uint32_t>().swap(p.fj);
+  }
   history.assign(i.size() * stride_, 0.0);
   touching.assign(i.size(), 0);
   if (!old.empty() && stride_ > 0) {
-    for (std::size_t k = 0; k < i.size(); ++k) {
-      auto it = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
-      if (it == old.end()) continue;
-      std::copy_n(old_history.begin() + static_cast<std::ptrdiff_t>(it->second * stride_), stride_,
-                  history.begin() + static_cast<std::ptrdiff_t>(k * stride_));
-      touching[k] = 1;
-    }
+    // look-ups in the (now read-only) map, each entry written by one thread
+    auto carry = [&](std::size_t first, std::size_t last) {
+      for (std::size_t k = first; k < last; ++k) {
+        auto it = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
+        if (it == old.end()) continue;
+        std::copy_n(old_history.begin() + static_cast<std::ptrdiff_t>(it->second * stride_), stride_,
+                    history.begin() + static_cast<std::ptrdiff_t>(k * stride_));
+        touching[k] = 1;
+      }
+    };
+    if (nt == 1) carry(0, i.size());
+    else pool->for_range(i.size(), [&](std::size_t first, std::size_t last, int) { carry(first, last); });
   }
   x0_ = s.x; y0_ = s.y; z0_ = s.z;
   built_ids_ = s.id;

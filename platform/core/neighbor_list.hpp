@@ -10,6 +10,7 @@
 #pragma once
 
 #include "core/particle_store.hpp"
+#include "core/thread_pool.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -49,7 +50,9 @@ class NeighborList {
   double near_gap() const { return kNearFraction * skin_; }
   double far_tier_displacement2() const { return 0.25 * near_gap() * near_gap(); }
   static constexpr double kNearFraction = 0.5;
-  void build(const ParticleStore& s);
+  /// Build from the store's positions; with a pool of several threads the
+  /// scan over particles runs in parallel (the same list as on one thread).
+  void build(const ParticleStore& s, ThreadPool* pool = nullptr);
   std::size_t size() const { return i.size(); }
   std::size_t builds() const { return builds_; }
 

@@ -171,7 +171,7 @@ void Subdomain::rebuild_lists() {
     reordered_size_ = store_.size();
   }
   ++builds_since_reorder_;
-  nlist_.build(store_);
+  nlist_.build(store_, pool_.get());
   far_active_ = false;
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     const WallPrimitive& wall = walls_now_[w];

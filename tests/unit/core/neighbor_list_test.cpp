@@ -71,6 +71,31 @@ TEST(NeighborList, FarOutliersLoseNoPairs) {
   EXPECT_TRUE(found.count({1, 2}));
 }
 
+TEST(NeighborList, ThreadedBuildGivesTheOneThreadList) {
+  // The scan runs per particle range and the ranges are joined in order, so
+  // the list, its tiers and the carried history must equal the serial build's.
+  const ParticleStore s = cloud(6000, 5);
+  NeighborList serial, threaded;
+  serial.configure(0.0008, 3);
+  threaded.configure(0.0008, 3);
+  ThreadPool pool(2);
+  serial.build(s);
+  threaded.build(s, &pool);
+  ASSERT_GT(serial.size(), 1000u);
+  EXPECT_EQ(serial.i, threaded.i);
+  EXPECT_EQ(serial.j, threaded.j);
+  EXPECT_EQ(serial.near_size(), threaded.near_size());
+  // history carried over by ids in a second build
+  for (std::size_t k = 0; k < serial.size(); k += 7) {
+    serial.touching[k] = threaded.touching[k] = 1;
+    for (int h = 0; h < 3; ++h) serial.history[3 * k + h] = threaded.history[3 * k + h] = 1.0 + k + h;
+  }
+  serial.build(s);
+  threaded.build(s, &pool);
+  EXPECT_EQ(serial.history, threaded.history);
+  EXPECT_EQ(serial.touching, threaded.touching);
+}
+
 TEST(NeighborList, CellsAreNeverNarrowerThanTheCutoff) {
   // regression: with floor(span/cutoff) + 1 cells per axis a cell was narrower
   // than the cutoff and this touching pair (2, 3), 0.9 apart, was missed
