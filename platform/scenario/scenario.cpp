@@ -542,6 +542,18 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
     for (int a = 0; a < 3; ++a) { prim.p[a] = p[a]; prim.n[a] = nrm[a] / len; }
     out.push_back(prim);
   };
+  // the axis, centre and extent an axis-aligned mantle (cylinder, cone) shares
+  auto mantle = [&](WallPrimitive::Shape shape) {
+    WallPrimitive m;
+    m.shape = shape;
+    m.name = name + ".mantle";
+    m.material = material;
+    m.axis = axis_index(member(w, "axis"));
+    for (int a = 0; a < 3; ++a) m.c[a] = w["center"][a].get<double>();
+    m.lo = w["bottom"].get<double>();
+    m.hi = w["top"].get<double>();
+    return m;
+  };
   if (type == "plane") {
     const double p[3] = {w["point"][0].get<double>(), w["point"][1].get<double>(), w["point"][2].get<double>()};
     const double n[3] = {w["normal"][0].get<double>(), w["normal"][1].get<double>(), w["normal"][2].get<double>()};
@@ -561,15 +573,8 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
       plane(name + "." + faces[f], p, n);
     }
   } else if (type == "cylinder") {
-    WallPrimitive m;
-    m.shape = WallPrimitive::Shape::cylinder_inside;
-    m.name = name + ".mantle";
-    m.material = material;
-    m.axis = axis_index(member(w, "axis"));
-    for (int a = 0; a < 3; ++a) m.c[a] = w["center"][a].get<double>();
+    WallPrimitive m = mantle(WallPrimitive::Shape::cylinder_inside);
     m.radius = w["radius"].get<double>();
-    m.lo = w["bottom"].get<double>();
-    m.hi = w["top"].get<double>();
     out.push_back(m);
     double p[3] = {m.c[0], m.c[1], m.c[2]}, n[3] = {0, 0, 0};
     if (w.value("closed_bottom", true)) {
@@ -600,16 +605,9 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
       plane(name + ".top", p, n);
     }
   } else if (type == "cone") {
-    WallPrimitive m;
-    m.shape = WallPrimitive::Shape::cone_inside;
-    m.name = name + ".mantle";
-    m.material = material;
-    m.axis = axis_index(member(w, "axis"));
-    for (int a = 0; a < 3; ++a) m.c[a] = w["center"][a].get<double>();
+    WallPrimitive m = mantle(WallPrimitive::Shape::cone_inside);
     m.radius = w["radius_bottom"].get<double>();
     m.radius_hi = w["radius_top"].get<double>();
-    m.lo = w["bottom"].get<double>();
-    m.hi = w["top"].get<double>();
     out.push_back(m);
     if (w.value("closed_bottom", false)) {
       WallPrimitive d;
@@ -736,6 +734,11 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     const std::string mat_name = sd["material"].get<std::string>();
     const double alpha = sd.value("coarse_grain", 1.0);
     const json contact = sd.value("contact", json::object());
+    // inserter seeds derive from the run seed, this hash of the subdomain's
+    // name and the inserter's position, so adding or removing another
+    // subdomain changes nothing here (FNV-1a)
+    std::uint64_t name_hash = 1469598103934665603ull;
+    for (unsigned char ch : sd_name) name_hash = (name_hash ^ ch) * 1099511628211ull;
 
     std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots;
     json used = json::object();
@@ -787,10 +790,6 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
           domel_insert_request_v1 req{};
           req.struct_size = sizeof(req);
           req.region = make_region(block["region"]);
-          // Derived from the run seed, the subdomain's name and the inserter's
-          // position, so adding or removing another subdomain changes nothing here.
-          std::uint64_t name_hash = 1469598103934665603ull;  // FNV-1a
-          for (unsigned char ch : sd_name) name_hash = (name_hash ^ ch) * 1099511628211ull;
           req.seed = block.contains("seed") ? block["seed"].get<std::uint64_t>()
                                             : sim->seed * 1000003ull + name_hash + q;
           req.length_scale = alpha;
@@ -840,8 +839,6 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
           if (pb.contains("total_mass")) p.total_mass = pb["total_mass"].get<double>();
           p.start = pb.value("start", 0.0);
           if (pb.contains("end")) p.end = pb["end"].get<double>();
-          std::uint64_t name_hash = 1469598103934665603ull;  // FNV-1a, as the start-up insertion
-          for (unsigned char ch : sd_name) name_hash = (name_hash ^ ch) * 1099511628211ull;
           p.seed = block.contains("seed") ? block["seed"].get<std::uint64_t>()
                                           : sim->seed * 1000003ull + name_hash + 7919ull * (q + 1);
           if (pb.contains("interval")) {
@@ -902,22 +899,21 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     // time step
     const double v_imp = sd.value("impact_velocity", 1.0);
     TimeStepReport rep;
-    bool probe_particle = false;  // the smallest poured particle, present only for the estimate
-    if (!pour_radii.empty()) {
+    // a pour's smallest particle, present only for the estimate (the
+    // smallest particle sets the Rayleigh time)
+    const bool probe_particle = !pour_radii.empty();
+    if (probe_particle)
       sub->store().add(0, 0.0, 0.0, 0.0, *std::min_element(pour_radii.begin(), pour_radii.end()),
                        sim->materials[mat_index.at(mat_name)].density);
-      probe_particle = true;
-    }
     try {
       rep = sub->estimate_time_step(v_imp);
     } catch (const PluginError& e) {
       ck.add(base + "/contact", std::string("the contact model failed while estimating the time step: ") + e.what());
       continue;
     }
-    const bool was_empty = sub->store().size() == (probe_particle ? 1u : 0u);
     if (probe_particle) sub->store().swap_remove(sub->store().size() - 1);
     const json ts = sd.value("time_step", json("auto"));
-    if (was_empty && pour_radii.empty()) {
+    if (sub->store().size() == 0 && !probe_particle) {
       if (!ts.is_number()) {
         ck.add(base + "/time_step", "cannot choose a time step automatically for a subdomain without particles",
                "give time_step in seconds");
@@ -926,7 +922,6 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
       rep.chosen = ts.get<double>();
       rep.reason = "given (no particles to check it against)";
     } else if (ts.is_number()) {
-      (void)was_empty;
       rep.chosen = ts.get<double>();
       rep.reason = "given";
       if (rep.chosen > rep.critical) {

@@ -80,6 +80,8 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   domel_insert_request_v1 req{};
   req.struct_size = sizeof(req);
   req.region = p.region;
+  // one seed per event: the pour's seed and the event count mixed with the
+  // multiplier and increment of Knuth's MMIX linear congruential generator
   req.seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
   req.length_scale = p.alpha;
   req.n_existing = st.size();
