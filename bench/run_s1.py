@@ -25,6 +25,7 @@ Usage:
     python3 bench/run_s1.py                       # N = 10000 50000, 3 reps, with LIGGGHTS if on PATH
     python3 bench/run_s1.py --sizes 10000 50000 --reps 3 --with-200k
     python3 bench/run_s1.py --quick               # N = 10000, 1 rep (smoke test)
+    python3 bench/run_s1.py --deck bed --threads 1 2   # the dense settled bed (bench/make_bed.py, docs/benchmarks.md)
     python3 bench/run_s1.py --no-peer             # domel only
     python3 bench/run_s1.py --report bench/results/s1_<timestamp>.csv   # re-print the tables of a run
 Exit status: 0 when every run succeeded, 1 when any failed (all other runs are still done), 2 on bad usage.
@@ -51,6 +52,10 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import make_s1  # noqa: E402  (same folder)
+import make_bed  # noqa: E402
+
+# The deck being run: "s1" (S1/S2, the peers' settle.in) or "bed" (the dense settled bed of make_bed.py).
+DECK = {"name": "s1", "bed_dir": None}
 
 NSETTLE = make_s1.NSETTLE
 NRUN = make_s1.NRUN
@@ -176,16 +181,24 @@ def scenario_file(n, workdir, rolling="none"):
     return path
 
 
+def steps():
+    """(untimed, timed) steps of the deck being run."""
+    return (make_bed.NSETTLE, make_bed.NRUN) if DECK["name"] == "bed" else (NSETTLE, NRUN)
+
+
 def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
     nx, ny, nz = make_s1.lattice_dims(n)
-    expected = nx * ny * nz
+    expected = n if DECK["name"] == "bed" else nx * ny * nz
+    nsettle, nrun = steps()
+    scen = (make_bed.scenario_file(n, DECK["bed_dir"], rolling) if DECK["name"] == "bed"
+            else scenario_file(n, workdir, rolling))
     code = "domel" if threads == 1 else "domel_%dt" % threads
     outdir = os.path.join(workdir, "%s_N%d_r%d" % (code, n, rep))
     log = outdir + ".screen"
     row = {"code": code, "N_requested": n, "rep": rep, "log": log}
     row["load1_start"] = load1()
-    rc, wall, cpu, samples = run_timed([domel, "run", scenario_file(n, workdir, rolling), "--out", outdir, "--quiet",
-                               "--time-after", str(NSETTLE), "--threads", str(threads)], workdir, log, timeout, env)
+    rc, wall, cpu, samples = run_timed([domel, "run", scen, "--out", outdir, "--quiet",
+                               "--time-after", str(nsettle), "--threads", str(threads)], workdir, log, timeout, env)
     row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)
     summary_path = os.path.join(outdir, "summary.json")
     if rc != 0 or not os.path.isfile(summary_path):
@@ -215,9 +228,9 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
         row["timed_cpu_s"] = tcpu
         row["particle_steps_per_cpu_s"] = row["N_actual"] * row["timed_steps"] / tcpu
     if row["N_actual"] != expected:
-        row.update(ok=0, error="N_actual %s != %d (lattice %dx%dx%d)" % (row["N_actual"], expected, nx, ny, nz))
-    elif row["timed_steps"] != NRUN:
-        row.update(ok=0, error="timed window has %s steps, expected %d" % (row["timed_steps"], NRUN))
+        row.update(ok=0, error="N_actual %s != %d" % (row["N_actual"], expected))
+    elif row["timed_steps"] != nrun:
+        row.update(ok=0, error="timed window has %s steps, expected %d" % (row["timed_steps"], nrun))
     else:
         row["ok"] = 1
     return row
@@ -236,7 +249,7 @@ def parse_liggghts(text):
             res["timed_wall_s"] = float(m.group(1))
             res["timed_steps"] = int(m.group(2))
     # thermo rows 'step atoms ke x' (thermo_modify norm no: total translational KE); keep the last at the end
-    final = NSETTLE + NRUN
+    final = sum(steps())
     for m in re.finditer(r"^\s*(\d+)\s+\d+\s+([-+0-9.eE]+)\s+[-+0-9.eE]+\s*$", text, re.M):
         if int(m.group(1)) == final:
             res["ke_translational_final_J"] = float(m.group(2))
@@ -257,8 +270,12 @@ def run_liggghts(liggghts, deckdir, n, rep, workdir, timeout, env, rolling="none
     tag = "liggghts_N%d_r%d" % (n, rep)
     log, screen = os.path.join(workdir, tag + ".log"), os.path.join(workdir, tag + ".screen")
     row = {"code": "liggghts", "N_requested": n, "rep": rep, "log": screen}
-    cmd = [liggghts, "-in", "settle.in", "-var", "N", str(n), "-var", "nsettle", str(NSETTLE),
-           "-var", "nrun", str(NRUN), "-var", "RF", rolling, "-log", log]
+    nsettle, nrun = steps()
+    if DECK["name"] == "bed":
+        cmd = [liggghts, "-in", "bed.in", "-var", "data", make_bed.paths(DECK["bed_dir"], n)["data"]]
+    else:
+        cmd = [liggghts, "-in", "settle.in", "-var", "N", str(n)]
+    cmd += ["-var", "nsettle", str(nsettle), "-var", "nrun", str(nrun), "-var", "RF", rolling, "-log", log]
     if shutil.which("stdbuf"):  # LIGGGHTS dies silently when stdout is a file (RESULTS.md, problem 2)
         cmd = ["stdbuf", "-oL"] + cmd
     row["load1_start"] = load1()
@@ -306,7 +323,7 @@ def print_tables(rows, sizes, have_peer, deck="S1 settle"):
         np_ = sum(1 for r in mine if r["code"] == "liggghts" and r.get("ok"))
         lines.append([str(nact), fmt_rate(d) + " (%d)" % nd,
                       (fmt_rate(p) + " (%d)" % np_) if have_peer else "not run", ratio, load])
-    print(deck + ", timed particle-steps/s (2000 steps after 2000 untimed); (runs); "
+    print(deck + ", timed particle-steps/s (%d steps after %d untimed); (runs); " % (steps()[1], steps()[0]) +
           "load = 1-min load average at the start of the runs")
     print_md(head, lines)
 
@@ -365,7 +382,7 @@ def print_tables(rows, sizes, have_peer, deck="S1 settle"):
 
     print()
     print("Sanity check (same physics?): mean particle-particle contacts per particle and translational KE at "
-          "step 4000 (medians over runs), neighbour-list builds in 4000 steps (domel counts its initial build, "
+          "step %d (medians over runs), neighbour-list builds in %d steps (domel counts its initial build, " % (sum(steps()), sum(steps())) +
           "LIGGGHTS does not); a single jitter seed scatters by several %, see docs/benchmarks.md")
     head = ["N", "domel contacts/particle", "LIGGGHTS zmean", "difference", "KE domel/LIGGGHTS",
             "domel builds", "LIGGGHTS builds"]
@@ -400,6 +417,15 @@ def fmt_csv(v):
     return "" if v is None else v
 
 
+def deck_title(deck, rolling):
+    if deck == "bed":
+        base = "Dense settled bed (bench/make_bed.py)"
+        return base if rolling == "none" else base + " with rolling (LIGGGHTS %s vs domel %s)" % (
+            rolling, make_s1.ROLLING[rolling]["model"])
+    return "S1 settle" if rolling == "none" else "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (
+        rolling, make_s1.ROLLING[rolling]["model"])
+
+
 def report(csv_path):
     """Re-print the tables from a CSV written by an earlier run."""
     num = {"N_requested", "N_actual", "rep", "ok", "timed_steps", "neighbor_builds_total"}
@@ -422,10 +448,11 @@ def report(csv_path):
             sizes.append(r["N_requested"])
     print("Results from %s" % csv_path)
     base = os.path.basename(csv_path)
-    deck = "S1 settle"
+    DECK["name"] = "bed" if base.startswith("bed_") else "s1"
+    deck = deck_title(DECK["name"], "none")
     for rf in make_s1.ROLLING:
-        if base.startswith("s2_%s_" % rf):
-            deck = "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (rf, make_s1.ROLLING[rf]["model"])
+        if base.startswith("s2_%s_" % rf) or base.startswith("bed_%s_" % rf):
+            deck = deck_title(DECK["name"], rf)
     print_tables(rows, sizes, any(r["code"] == "liggghts" for r in rows), deck)
     return 0 if all(r.get("ok") for r in rows) else 1
 
@@ -448,6 +475,12 @@ def main(argv=None):
                          "against domel sd_critical_angle (theta_c = atan 0.1)")
     ap.add_argument("--threads", type=int, nargs="+", default=[1],
                     help="domel thread counts to run (default 1; e.g. --threads 1 2); LIGGGHTS always runs serially")
+    ap.add_argument("--deck", choices=["s1", "bed"], default="s1",
+                    help="s1: the peers' S1/S2 lattice column (default); bed: the dense settled bed of "
+                         "bench/make_bed.py (both codes start from the same bed file; prepared once by domel, cached "
+                         "in --bed-dir)")
+    ap.add_argument("--bed-dir", default=os.path.join(HERE, "work"),
+                    help="where make_bed.py keeps the prepared beds (default bench/work, git-ignored)")
     ap.add_argument("--report", metavar="CSV", help="only print the tables of an earlier run's CSV, run nothing")
     ap.add_argument("--workdir", help="where logs and domel outputs go (default: a fresh temp dir, kept)")
     args = ap.parse_args(argv)
@@ -488,10 +521,17 @@ def main(argv=None):
         shutil.copytree(os.path.join(args.peers, "liggghts"), os.path.join(peer_copy, "liggghts"), dirs_exist_ok=True)
         shutil.copy2(os.path.join(args.peers, "cpusec.sh"), os.path.join(peer_copy, "cpusec.sh"))
         deckdir = os.path.join(peer_copy, "liggghts")
+        shutil.copy2(os.path.join(HERE, "liggghts", "bed.in"), os.path.join(deckdir, "bed.in"))
+    DECK["name"] = args.deck
+    if args.deck == "bed":
+        DECK["bed_dir"] = os.path.abspath(args.bed_dir)
+        for n in sizes:  # untimed, before any timed run; cached between invocations
+            _, facts = make_bed.prepare(n, DECK["bed_dir"], args.domel, threads=max(args.threads))
+            print("bed N = %d: %.2f contacts per particle, solid fraction %.3f at the end of the preparation"
+                  % (n, facts["contacts_per_particle_prep"], facts["solid_fraction_lower80"]))
 
     info = machine_info()
-    deck = "S1 settle" if args.rolling == "none" else "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (
-        args.rolling, make_s1.ROLLING[args.rolling]["model"])
+    deck = deck_title(args.deck, args.rolling)
     print("%s benchmark %s on %s: %s cores, %s; load average %s" % (deck,
         stamp, info["host"], info["nproc"], info["cpu"], " ".join("%.2f" % x for x in os.getloadavg())))
     print("domel: %s" % args.domel)
@@ -501,8 +541,11 @@ def main(argv=None):
     print()
 
     os.makedirs(args.results, exist_ok=True)
-    csv_path = os.path.join(args.results, ("s1_%s.csv" % stamp) if args.rolling == "none" else
-                            ("s2_%s_%s.csv" % (args.rolling, stamp)))
+    if args.deck == "bed":
+        csv_name = ("bed_%s.csv" % stamp) if args.rolling == "none" else ("bed_%s_%s.csv" % (args.rolling, stamp))
+    else:
+        csv_name = ("s1_%s.csv" % stamp) if args.rolling == "none" else ("s2_%s_%s.csv" % (args.rolling, stamp))
+    csv_path = os.path.join(args.results, csv_name)
     rows = []
     with open(csv_path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=CSV_FIELDS)

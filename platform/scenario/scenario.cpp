@@ -4,6 +4,7 @@
 
 #include "geometry/region.hpp"
 #include "geometry/triangle_mesh.hpp"
+#include "io/particle_state.hpp"
 #include "scenario/json_schema.hpp"
 
 #include <spdlog/spdlog.h>
@@ -393,6 +394,18 @@ void check_references(Checker& ck, const json& doc) {
                      "' makes particles of this material");
         sd_materials.emplace_back(name && name->is_string() ? name->get<std::string>() : std::to_string(k), mat);
       }
+      if (const json* st = member(sd, "initial_state"); st && st->is_string() && !st->get<std::string>().empty()) {
+        std::filesystem::path f = st->get<std::string>();
+        if (f.is_relative()) f = ck.file.parent_path() / f;
+        try {
+          if (io::read_particle_state(f).empty())
+            ck.add(base + "/initial_state", "expected at least one particle in " + f.string() + ", found none");
+        } catch (const std::exception& e) {
+          ck.add(base + "/initial_state", e.what(),
+                 std::filesystem::exists(f) ? "write it with output.state: true in an earlier run"
+                                            : "paths in \"initial_state\" are relative to the scenario's folder");
+        }
+      }
     }
   }
 
@@ -777,8 +790,27 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     sub->set_environment(sim->materials, wall_coeffs, coeffs.at(std::minmax(mat_name, mat_name)), &sim->walls,
                          sim->gravity);
 
-    // insertion
+    // insertion: a state file first, then the inserters (which avoid its particles)
     const std::size_t problems_before_insert = ck.diags.size();
+    if (sd.contains("initial_state")) {
+      std::filesystem::path f = sd["initial_state"].get<std::string>();
+      if (f.is_relative()) f = file.parent_path() / f;
+      try {
+        const auto rows = io::read_particle_state(f);
+        ParticleStore& st = sub->store();
+        const double density = sim->materials[mat_index.at(mat_name)].density;
+        for (const auto& p : rows) {
+          st.add(next_id++, p.x, p.y, p.z, p.radius, density, p.fixed);
+          if (p.fixed) continue;  // a fixed particle stays at rest
+          st.vx.back() = p.vx; st.vy.back() = p.vy; st.vz.back() = p.vz;
+          st.wx.back() = p.wx; st.wy.back() = p.wy; st.wz.back() = p.wz;
+        }
+        spdlog::info("subdomain '{}': {} particles from {} (contact history starts at zero)", sd_name, rows.size(),
+                     f.string());
+      } catch (const std::exception& e) {
+        ck.add(base + "/initial_state", e.what());
+      }
+    }
     if (sd.contains("insert")) {
       for (std::size_t q = 0; q < sd["insert"].size(); ++q) {
         const json& block = sd["insert"][q];
@@ -1040,6 +1072,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   sim->output_directory = out.value("directory", sim->name + "_out");
   sim->vtk_interval = out.value("vtk_interval", sim->duration / 50.0);
   sim->probe_interval = out.value("probe_interval", sim->duration / 500.0);
+  sim->write_state = out.value("state", false);
   for (auto& g : sim->grid_setups)
     if (g.spec.write_interval < 0) g.spec.write_interval = sim->duration / 20.0;
   if (out.contains("repose_angle")) {

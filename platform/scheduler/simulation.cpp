@@ -8,11 +8,13 @@
 #include "io/atomic_file.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
+#include "io/particle_state.hpp"
 #include "io/vtk_writer.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -296,6 +298,15 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                                {"particle_steps_per_s", w > 0 ? window_particle_steps / w : 0.0}};
   }
   nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
+  if (write_state) {
+    for (const auto& sd : subdomains) {
+      std::string f = sd->name() + "_state.csv";
+      for (char& c : f)  // a file name whatever the subdomain is called
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '_';
+      io::write_particle_state(out / f, sd->store(), sd->name(), result.simulated_time, sd->coarse_grain());
+      files["state"][sd->name()] = f;
+    }
+  }
   for (std::size_t g = 0; g < grids.size(); ++g)
     if (grid_vtk[g]) files["grids"][grid_setups[g].spec.name] = {{"series", grid_setups[g].spec.name + ".pvd"},
                                                                 {"profile", grid_setups[g].spec.name + "_profile.csv"}};

@@ -54,6 +54,7 @@ class Simulation {
   int threads = 0;  ///< the scenario's run.threads; 0: not given (DOMEL_THREADS, else 1)
   double vtk_interval = 0;
   double probe_interval = 0;
+  bool write_state = false;  ///< output.state: <subdomain>_state.csv at the end (io/particle_state.hpp)
   std::optional<ReposeProbeSettings> repose_probe;  ///< adds <subdomain>.repose_angle_deg to probes.csv
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
