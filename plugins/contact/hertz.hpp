@@ -29,14 +29,14 @@ class Hertz {
   explicit Hertz(const sdk::Params&) {}
 
   void compute(domel_contact_batch_v1& b) const {
-    const double e_eff = b.pair->youngs_eff;
-    const uint32_t n = b.n;
-    const double* __restrict r_eff = b.r_eff;
-    const double* __restrict overlap = b.overlap;
-    double* __restrict radius = b.contact_radius;
-    double* __restrict kn = b.kn;
-    double* __restrict kn_tangent = b.kn_tangent;
-    double* __restrict fn_elastic = b.fn_elastic;
+    kernel(b.n, b.pair->youngs_eff, b.r_eff, b.overlap, b.contact_radius, b.kn, b.kn_tangent, b.fn_elastic);
+  }
+
+ private:
+  // __restrict parameters (GCC ignores restrict on local pointers): the loop vectorises.
+  static void kernel(uint32_t n, double e_eff, const double* __restrict r_eff, const double* __restrict overlap,
+                     double* __restrict radius, double* __restrict kn, double* __restrict kn_tangent,
+                     double* __restrict fn_elastic) {
     for (uint32_t c = 0; c < n; ++c) {
       const double a = std::sqrt(r_eff[c] * overlap[c]);
       const double k = (4.0 / 3.0) * e_eff * a;

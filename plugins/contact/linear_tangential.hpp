@@ -42,13 +42,7 @@ class LinearTangential {
         damping_ratio_(p.number_or("damping_ratio", std::sqrt(stiffness_ratio_))) {}
 
   void compute(domel_contact_batch_v1& b) const {
-    const double* __restrict kn = b.kn;
-    const double* __restrict eta_n = b.eta_n;
-    const double ks = stiffness_ratio_, ds = damping_ratio_;
-    tangential_spring_coulomb(b, [=](uint32_t c, double& kt, double& eta_t) {
-      kt = ks * kn[c];
-      eta_t = ds * eta_n[c];
-    });
+    tangential_spring_coulomb<Dashpot::kScaled>(b, stiffness_ratio_, damping_ratio_, b.kn, b.eta_n);
   }
 
  private:

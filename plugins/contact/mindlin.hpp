@@ -38,12 +38,7 @@ class Mindlin {
     const double le = std::log(b.pair->restitution);
     const double c_damp =
         damping_ ? 2.0 * std::sqrt(5.0 / 6.0) * std::fabs(le) / std::sqrt(le * le + M_PI * M_PI) : 0.0;
-    const double* __restrict a = b.contact_radius;
-    const double* __restrict m_eff = b.m_eff;
-    tangential_spring_coulomb(b, [=](uint32_t c, double& kt, double& eta_t) {
-      kt = 8.0 * g_eff * a[c];
-      eta_t = c_damp * std::sqrt(kt * m_eff[c]);
-    });
+    tangential_spring_coulomb<Dashpot::kSqrtMass>(b, 8.0 * g_eff, c_damp, b.contact_radius, b.m_eff);
   }
 
  private:
