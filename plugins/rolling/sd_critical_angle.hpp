@@ -65,24 +65,57 @@ class SdCriticalAngle {
   }
 
   void compute(domel_contact_batch_v1& b) const {
-    kernel(b.n, b.history_stride, b.dt, tan_c_, damping_at_yield_ ? 1.0 : 0.0, b.r_eff,
-           tangent_ ? b.kn_tangent : b.kn, b.eta_n, b.fn_elastic, b.nx, b.ny, b.nz, b.wx, b.wy, b.wz, b.history,
-           b.tqx, b.tqy, b.tqz, b.rolling_stiffness, b.rolling_damping);
+    // Two passes, so that the common case (elastic) runs vectorised and
+    // without divisions: the elastic pass, then the few yielded contacts
+    // redone from the angle it stored (the same expressions, so the results
+    // are those of a one-pass if/else loop bit for bit, the sign of a zero
+    // torque aside).
+    const uint32_t s = b.history_stride;
+    double yield[kChunk];
+    for (uint32_t c0 = 0; c0 < b.n; c0 += kChunk) {
+      const uint32_t m = b.n - c0 < kChunk ? b.n - c0 : kChunk;
+      const double* kn = tangent_ ? b.kn_tangent : b.kn;
+      const double yields =
+          elastic_pass(m, s, b.dt, tan_c_, b.r_eff + c0, kn + c0, b.eta_n + c0, b.fn_elastic + c0, b.nx + c0,
+                       b.ny + c0, b.nz + c0, b.wx + c0, b.wy + c0, b.wz + c0, b.history + static_cast<size_t>(c0) * s,
+                       b.tqx + c0, b.tqy + c0, b.tqz + c0, b.rolling_stiffness + c0, b.rolling_damping + c0, yield);
+      if (yields == 0.0) continue;
+      for (uint32_t q = 0; q < m; ++q) {
+        if (yield[q] == 0.0) continue;
+        const uint32_t c = c0 + q;
+        double* th = b.history + static_cast<size_t>(c) * s;  // holds the new angle
+        const double a = b.r_eff[c] * tan_c_;
+        const double k = 0.25 * kn[c] * a * a;
+        const double eta = 0.25 * b.eta_n[c] * a * a;
+        const double m_ref = a * cap_force(b.fn_elastic[c]);
+        const Vec3 w = rolling_velocity(b.wx[c], b.wy[c], b.wz[c], b.nx[c], b.ny[c], b.nz[c]);
+        double m0 = -k * th[0], m1 = -k * th[1], m2 = -k * th[2];
+        const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
+        const double scale = m_ref / ms;  // ms > m_ref >= 0
+        m0 *= scale; m1 *= scale; m2 *= scale;
+        if (k > 0.0) { th[0] = -m0 / k; th[1] = -m1 / k; th[2] = -m2 / k; }
+        else { th[0] = th[1] = th[2] = 0.0; }
+        if (damping_at_yield_) { m0 -= eta * w.x; m1 -= eta * w.y; m2 -= eta * w.z; }
+        b.tqx[c] += m0; b.tqy[c] += m1; b.tqz[c] += m2;
+      }
+    }
   }
 
  private:
-  // A free function with __restrict parameters (GCC ignores restrict on
-  // local pointers) and no branches, so that the loop vectorises: selects
-  // (with -fno-trapping-math GCC computes both sides), and the dashpot
-  // weighted by 1 or 0 so that no load is conditional. The results are those
-  // of the if/else form bit for bit (the sign of a zero torque aside).
-  static void kernel(uint32_t n, uint32_t s, double dt, double tan_c, double damp_at_yield,
-                     const double* __restrict r_eff, const double* __restrict kn, const double* __restrict eta_n,
-                     const double* __restrict fn_el, const double* __restrict nx, const double* __restrict ny,
-                     const double* __restrict nz, const double* __restrict wx, const double* __restrict wy,
-                     const double* __restrict wz, double* __restrict hist, double* __restrict tqx,
-                     double* __restrict tqy, double* __restrict tqz, double* __restrict k_out,
-                     double* __restrict eta_out) {
+  static constexpr uint32_t kChunk = 256;  // contacts per elastic pass (a stack array of yield flags)
+
+  // Pass 1: every contact as if elastic; a yield flag (1.0/0.0) per contact;
+  // yielded contacts add no torque here. A free function with __restrict
+  // parameters (GCC ignores restrict on local pointers) and no branches, so
+  // that the loop vectorises. Returns the number of yielded contacts.
+  static double elastic_pass(uint32_t n, uint32_t s, double dt, double tan_c, const double* __restrict r_eff,
+                             const double* __restrict kn, const double* __restrict eta_n,
+                             const double* __restrict fn_el, const double* __restrict nx,
+                             const double* __restrict ny, const double* __restrict nz, const double* __restrict wx,
+                             const double* __restrict wy, const double* __restrict wz, double* __restrict hist,
+                             double* __restrict tqx, double* __restrict tqy, double* __restrict tqz,
+                             double* __restrict k_out, double* __restrict eta_out, double* __restrict yield) {
+    double yields = 0.0;
     for (uint32_t c = 0; c < n; ++c) {
       double* th = hist + static_cast<size_t>(c) * s;
       const double a = r_eff[c] * tan_c;
@@ -91,35 +124,27 @@ class SdCriticalAngle {
       const double m_ref = a * cap_force(fn_el[c]);
       const double n0 = nx[c], n1 = ny[c], n2 = nz[c];
       const Vec3 w = rolling_velocity(wx[c], wy[c], wz[c], n0, n1, n2);
-      const double w0 = w.x, w1 = w.y, w2 = w.z;
       // rotate the stored angle into the current tangent plane, keeping its length
       const double len0 = std::sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
       const double proj = th[0] * n0 + th[1] * n1 + th[2] * n2;
       double t0 = th[0] - proj * n0, t1 = th[1] - proj * n1, t2 = th[2] - proj * n2;
       const double len1 = std::sqrt(t0 * t0 + t1 * t1 + t2 * t2);
       const double keep = len1 > 0.0 ? len0 / len1 : 1.0;
-      t0 = t0 * keep + w0 * dt; t1 = t1 * keep + w1 * dt; t2 = t2 * keep + w2 * dt;
-      double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
+      t0 = t0 * keep + w.x * dt; t1 = t1 * keep + w.y * dt; t2 = t2 * keep + w.z * dt;
+      const double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
       const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
-      // above the cap (then ms > m_ref >= 0): M_s scaled to M_ref, theta_r = -M_s/k_th
-      const bool yielded = ms > m_ref;
-      const double q = m_ref / (yielded ? ms : 1.0);
-      const double scale = yielded ? q : 1.0;
-      m0 *= scale; m1 *= scale; m2 *= scale;
-      const bool rescale = yielded & (k > 0.0);
-      const double kd = rescale ? k : 1.0;
-      const double elastic = yielded ? 0.0 : 1.0;  // k_th = 0 at yield: theta_r = 0
-      th[0] = rescale ? -m0 / kd : elastic * t0;
-      th[1] = rescale ? -m1 / kd : elastic * t1;
-      th[2] = rescale ? -m2 / kd : elastic * t2;
-      // the dashpot while elastic (and at yield with damping_at_yield): weighted by 1 or 0, not selected
-      const double damp = (yielded ? damp_at_yield : 1.0) * eta;
-      tqx[c] += m0 - damp * w0;
-      tqy[c] += m1 - damp * w1;
-      tqz[c] += m2 - damp * w2;
+      const double flag = ms > m_ref ? 1.0 : 0.0;  // above the cap: redone in the second pass
+      yield[c] = flag;
+      yields += flag;
+      const double elastic = 1.0 - flag;
+      th[0] = t0; th[1] = t1; th[2] = t2;
+      tqx[c] += elastic * (m0 - eta * w.x);  // spring and dashpot while elastic
+      tqy[c] += elastic * (m1 - eta * w.y);
+      tqz[c] += elastic * (m2 - eta * w.z);
       k_out[c] = k;
       eta_out[c] = eta;
     }
+    return yields;
   }
 
   double tan_c_;
