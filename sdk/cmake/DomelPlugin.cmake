@@ -18,6 +18,12 @@ function(domel_add_plugin name)
     target_link_options(${name} PRIVATE "LINKER:--version-script=${map}")
     set_property(TARGET ${name} APPEND PROPERTY LINK_DEPENDS ${map})
   endif()
+  # The flags domel's own kernels are built with (docs/sdk-guide.md, "Fast batch kernels"): sqrt without the
+  # errno path and no floating-point traps, so that branch-free loops over a batch vectorise. Neither
+  # changes a value (no re-association, no contraction).
+  if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+    target_compile_options(${name} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:-fno-math-errno -fno-trapping-math>)
+  endif()
   if(ARG_OUTPUT_DIRECTORY)
     set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})
   endif()
