@@ -67,56 +67,55 @@ def prep_params(n):
             "extra_s": PREP_EXTRA_S, "seed": PREP_SEED}
 
 
+def deck(name, description, n, restitution, friction, box_top, subdomain, steps, output):
+    """The scenario both the preparation and the benchmark use: S1's material, time step and skin, one subdomain
+    'bed' of Hertz + restitution + Mindlin spheres (plus `subdomain`'s keys) in a box of S1's footprint."""
+    side = round(footprint(n), 12)
+    sd = {"name": "bed", "material": "beads",
+          "contact": {"normal": {"model": "hertz"}, "damping": {"model": "restitution"},
+                      "tangential": {"model": "mindlin"}},
+          "time_step": DT, "skin": SKIN}
+    for key, value in subdomain.items():
+        if key == "contact":
+            sd["contact"].update(value)
+        else:
+            sd[key] = value
+    return {
+        "name": name,
+        "description": description,
+        "gravity": [0, 0, -9.81],
+        "materials": {"beads": {"density": RHO, "youngs_modulus": E, "poisson_ratio": NU}},
+        "interactions": [{"materials": ["beads", "beads"], "restitution": restitution, "friction": friction}],
+        "walls": [{"name": "box", "type": "box", "material": "beads", "min": [0, 0, 0],
+                   "max": [side, side, round(box_top, 12)], "open": ["zmax"]}],
+        "subdomains": [sd],
+        "run": {"steps": steps, "seed": 1},
+        "output": dict({"vtk_interval": 0, "probe_interval": 0}, **output),
+    }
+
+
 def prep_scenario(n):
     side = round(footprint(n), 12)
     h = fill_height(n)
     duration = math.sqrt(2.0 * h / 9.81) + PREP_EXTRA_S
-    steps = int(math.ceil(duration / DT))
-    return {
-        "name": "bed_prep_%s" % make_s1.label(n),
-        "description": "Preparation of the dense-bed benchmark (bench/make_bed.py): %d spheres fall frictionless "
-                       "from a random fill into a box" % n,
-        "gravity": [0, 0, -9.81],
-        "materials": {"beads": {"density": RHO, "youngs_modulus": E, "poisson_ratio": NU}},
-        "interactions": [{"materials": ["beads", "beads"], "restitution": PREP_RESTITUTION, "friction": 0.0}],
-        "walls": [{"name": "box", "type": "box", "material": "beads", "min": [0, 0, 0],
-                   "max": [side, side, round(1.05 * h + 2 * D, 12)], "open": ["zmax"]}],
-        "subdomains": [{
-            "name": "bed", "material": "beads",
-            "contact": {"normal": {"model": "hertz"}, "damping": {"model": "restitution"},
-                        "tangential": {"model": "mindlin"}},
-            "time_step": DT, "skin": SKIN,
-            "insert": [{"model": "random", "region": {"box": {"min": [0, 0, 0], "max": [side, side, round(h, 12)]}},
-                        "diameter": D, "count": n, "seed": PREP_SEED}],
-        }],
-        "run": {"steps": steps, "seed": 1},
-        "output": {"vtk_interval": 0, "probe_interval": 0, "state": True},
-    }
+    fill = {"model": "random", "region": {"box": {"min": [0, 0, 0], "max": [side, side, round(h, 12)]}},
+            "diameter": D, "count": n, "seed": PREP_SEED}
+    return deck("bed_prep_%s" % make_s1.label(n),
+                "Preparation of the dense-bed benchmark (bench/make_bed.py): %d spheres fall frictionless "
+                "from a random fill into a box" % n,
+                n, PREP_RESTITUTION, 0.0, 1.05 * h + 2 * D, {"insert": [fill]}, int(math.ceil(duration / DT)),
+                {"state": True})
 
 
 def bed_scenario(n, top, rolling="none"):
-    side = round(footprint(n), 12)
     lab = make_s1.label(n)
     name = "bed_%s" % lab if rolling == "none" else "bed_%s_%s" % (lab, make_s1.ROLLING[rolling]["model"])
-    return {
-        "name": name,
-        "description": "Dense settled-bed benchmark (bench/make_bed.py): %d spheres at rest, S1 material and "
-                       "contact model, run %d + %d steps with --time-after %d" % (n, NSETTLE, NRUN, NSETTLE),
-        "gravity": [0, 0, -9.81],
-        "materials": {"beads": {"density": RHO, "youngs_modulus": E, "poisson_ratio": NU}},
-        "interactions": [{"materials": ["beads", "beads"], "restitution": REST, "friction": MU}],
-        "walls": [{"name": "box", "type": "box", "material": "beads", "min": [0, 0, 0],
-                   "max": [side, side, round(top, 12)], "open": ["zmax"]}],
-        "subdomains": [{
-            "name": "bed", "material": "beads",
-            "contact": {"normal": {"model": "hertz"}, "damping": {"model": "restitution"},
-                        "tangential": {"model": "mindlin"}, "rolling": dict(make_s1.ROLLING[rolling])},
-            "time_step": DT, "skin": SKIN,
-            "initial_state": "bed_%s.csv" % lab,
-        }],
-        "run": {"steps": NSETTLE + NRUN, "seed": 1},
-        "output": {"vtk_interval": 0, "probe_interval": 0},
-    }
+    return deck(name,
+                "Dense settled-bed benchmark (bench/make_bed.py): %d spheres at rest, S1 material and "
+                "contact model, run %d + %d steps with --time-after %d" % (n, NSETTLE, NRUN, NSETTLE),
+                n, REST, MU, top,
+                {"contact": {"rolling": dict(make_s1.ROLLING[rolling])}, "initial_state": "bed_%s.csv" % lab},
+                NSETTLE + NRUN, {})
 
 
 def read_state(path):

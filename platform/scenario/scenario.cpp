@@ -48,6 +48,13 @@ std::string fmt_num(double v) {
   return os.str();
 }
 
+/// A file named in the scenario (mesh, plugin, state file): a relative path
+/// is relative to the scenario's folder.
+std::filesystem::path scenario_path(const std::filesystem::path& scenario_file, const std::string& named) {
+  std::filesystem::path p = named;
+  return p.is_relative() ? scenario_file.parent_path() / p : p;
+}
+
 /// Validation state shared by the passes.
 struct Checker {
   std::filesystem::path file;
@@ -313,8 +320,7 @@ void check_references(Checker& ck, const json& doc) {
                                              fmt_num(ri->get<double>()) + " >= radius " + fmt_num(r->get<double>()));
       }
       if (t == "mesh" && member(w, "file") && w["file"].is_string()) {
-        std::filesystem::path f = w["file"].get<std::string>();
-        if (f.is_relative()) f = ck.file.parent_path() / f;
+        const std::filesystem::path f = scenario_path(ck.file, w["file"].get<std::string>());
         try {
           const TriangleMesh m = load_stl_mesh(f, 1.0, std::array<double, 3>{0, 0, 0}.data());
           (void)m;
@@ -395,8 +401,7 @@ void check_references(Checker& ck, const json& doc) {
         sd_materials.emplace_back(name && name->is_string() ? name->get<std::string>() : std::to_string(k), mat);
       }
       if (const json* st = member(sd, "initial_state"); st && st->is_string() && !st->get<std::string>().empty()) {
-        std::filesystem::path f = st->get<std::string>();
-        if (f.is_relative()) f = ck.file.parent_path() / f;
+        const std::filesystem::path f = scenario_path(ck.file, st->get<std::string>());
         try {
           if (io::read_particle_state(f).empty())
             ck.add(base + "/initial_state", "expected at least one particle in " + f.string() + ", found none");
@@ -478,8 +483,7 @@ std::vector<Diagnostic> validate_document(const json& doc, const std::filesystem
   if (const json* plugins = member(doc, "plugins"); plugins && plugins->is_array()) {
     for (std::size_t k = 0; k < plugins->size(); ++k) {
       if (!(*plugins)[k].is_string()) continue;
-      std::filesystem::path p = (*plugins)[k].get<std::string>();
-      if (p.is_relative()) p = file.parent_path() / p;
+      const std::filesystem::path p = scenario_path(file, (*plugins)[k].get<std::string>());
       try {
         registry.load(p);
       } catch (const PluginError& e) {
@@ -542,7 +546,8 @@ domel_region_v1 make_region(const json& region) {
   return r;
 }
 
-std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material, const std::filesystem::path& dir) {
+std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material,
+                                             const std::filesystem::path& scenario_file) {
   std::vector<WallPrimitive> out;
   const std::string name = w["name"].get<std::string>();
   const std::string type = w["type"].get<std::string>();
@@ -652,8 +657,7 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
     d.r_outer = w["radius"].get<double>();
     out.push_back(d);
   } else {  // mesh
-    std::filesystem::path f = w["file"].get<std::string>();
-    if (f.is_relative()) f = dir / f;
+    const std::filesystem::path f = scenario_path(scenario_file, w["file"].get<std::string>());
     double tr[3] = {0, 0, 0};
     if (w.contains("translate"))
       for (int a = 0; a < 3; ++a) tr[a] = w["translate"][a].get<double>();
@@ -674,8 +678,8 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
   return out;
 }
 
-std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material, const std::filesystem::path& dir) {
-  std::vector<WallPrimitive> out = expand_wall_shape(w, material, dir);
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material, const std::filesystem::path& scenario_file) {
+  std::vector<WallPrimitive> out = expand_wall_shape(w, material, scenario_file);
   if (w.contains("remove_at"))
     for (auto& p : out) p.remove_at = std::min(p.remove_at, w["remove_at"].get<double>());
   if (const json* mo = member(w, "motion")) {
@@ -727,7 +731,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   if (doc.contains("walls"))
     for (const auto& w : doc["walls"]) {
       try {
-        auto prims = expand_wall(w, mat_index.at(w["material"].get<std::string>()), file.parent_path());
+        auto prims = expand_wall(w, mat_index.at(w["material"].get<std::string>()), file);
         sim->walls.insert(sim->walls.end(), prims.begin(), prims.end());
       } catch (const MeshError& e) {  // the file changed since validation
         ck.add("/walls", e.what());
@@ -793,8 +797,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     // insertion: a state file first, then the inserters (which avoid its particles)
     const std::size_t problems_before_insert = ck.diags.size();
     if (sd.contains("initial_state")) {
-      std::filesystem::path f = sd["initial_state"].get<std::string>();
-      if (f.is_relative()) f = file.parent_path() / f;
+      const std::filesystem::path f = scenario_path(file, sd["initial_state"].get<std::string>());
       try {
         const auto rows = io::read_particle_state(f);
         ParticleStore& st = sub->store();

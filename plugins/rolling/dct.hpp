@@ -56,8 +56,7 @@ class Dct {
                      double* __restrict tqx, double* __restrict tqy, double* __restrict tqz) {
     for (uint32_t c = 0; c < n; ++c) {
       const Vec3 w = rolling_velocity(wx[c], wy[c], wz[c], nx[c], ny[c], nz[c]);
-      const double w0 = w.x, w1 = w.y, w2 = w.z;
-      const double len = std::sqrt(w0 * w0 + w1 * w1 + w2 * w2);
+      const double len = std::sqrt(w.x * w.x + w.y * w.y + w.z * w.z);
       // No rolling: also when only round-off of removing a pure twist is left
       // (its direction would be random and the torque is full-size).
       const double full = std::sqrt(wx[c] * wx[c] + wy[c] * wy[c] + wz[c] * wz[c]);
@@ -65,7 +64,7 @@ class Dct {
       const double cap = cap_force(fn_el[c]);
       // every contact takes the same arithmetic (times 0 when not rolling), so no load or division is conditional
       const double m = (rolling ? 1.0 : 0.0) * (mu_r * r_eff[c] * cap / (rolling ? len : 1.0));
-      tqx[c] -= m * w0; tqy[c] -= m * w1; tqz[c] -= m * w2;
+      tqx[c] -= m * w.x; tqy[c] -= m * w.y; tqz[c] -= m * w.z;
     }
   }
 

@@ -84,10 +84,8 @@ class SdCriticalAngle {
         if (yield[q] == 0.0) continue;
         const uint32_t c = c0 + q;
         double* th = b.history + static_cast<size_t>(c) * s;  // holds the new angle
-        const double a = b.r_eff[c] * tan_c_;
-        const double k = 0.25 * kn[c] * a * a;
-        const double eta = 0.25 * b.eta_n[c] * a * a;
-        const double m_ref = a * cap_force(b.fn_elastic[c]);
+        const Constants p = constants(b.r_eff[c], kn[c], b.eta_n[c], b.fn_elastic[c], tan_c_);
+        const double k = p.k, eta = p.eta, m_ref = p.m_ref;
         const Vec3 w = rolling_velocity(b.wx[c], b.wy[c], b.wz[c], b.nx[c], b.ny[c], b.nz[c]);
         double m0 = -k * th[0], m1 = -k * th[1], m2 = -k * th[2];
         const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
@@ -102,7 +100,18 @@ class SdCriticalAngle {
   }
 
  private:
-  static constexpr uint32_t kChunk = 256;  // contacts per elastic pass (a stack array of yield flags)
+  static constexpr uint32_t kChunk = 256;
+
+  // The contact's rolling constants from theta_c (the header's formulas,
+  // docs/physics.md §3.1-§3.3): spring k_th = k_n a^2/4, dashpot
+  // n_th = eta_n a^2/4, cap M_ref = a F_cap, with a = R* tan(theta_c).
+  struct Constants {
+    double k, eta, m_ref;
+  };
+  static Constants constants(double r_eff, double kn, double eta_n, double fn_el, double tan_c) {
+    const double a = r_eff * tan_c;
+    return {0.25 * kn * a * a, 0.25 * eta_n * a * a, a * cap_force(fn_el)};
+  }  // contacts per elastic pass (a stack array of yield flags)
 
   // Pass 1: every contact as if elastic; a yield flag (1.0/0.0) per contact;
   // yielded contacts add no torque here. A free function with __restrict
@@ -118,10 +127,8 @@ class SdCriticalAngle {
     double yields = 0.0;
     for (uint32_t c = 0; c < n; ++c) {
       double* th = hist + static_cast<size_t>(c) * s;
-      const double a = r_eff[c] * tan_c;
-      const double k = 0.25 * kn[c] * a * a;
-      const double eta = 0.25 * eta_n[c] * a * a;
-      const double m_ref = a * cap_force(fn_el[c]);
+      const Constants p = constants(r_eff[c], kn[c], eta_n[c], fn_el[c], tan_c);
+      const double k = p.k, eta = p.eta, m_ref = p.m_ref;
       const double n0 = nx[c], n1 = ny[c], n2 = nz[c];
       const Vec3 w = rolling_velocity(wx[c], wy[c], wz[c], n0, n1, n2);
       // rotate the stored angle into the current tangent plane, keeping its length
