@@ -19,6 +19,7 @@
 #include <limits>
 #include <sstream>
 #include <tuple>
+#include <utility>
 
 namespace domel::platform {
 
@@ -29,6 +30,7 @@ Subdomain::Subdomain(std::string name, double coarse_grain, std::size_t material
 }
 
 void Subdomain::set_threads(int threads) {
+  if (pool_) synchronize();  // a pending force sum lives in the scratch being replaced
   pool_ = std::make_unique<ThreadPool>(threads);
   scratch_.clear();
   scratch_.resize(static_cast<std::size_t>(std::max(1, threads)));
@@ -57,6 +59,7 @@ void Subdomain::set_environment(const std::vector<Material>& materials,
 }
 
 TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
+  synchronize();
   TimeStepReport rep;
   if (store_.size() == 0) return rep;
   std::size_t smallest = 0;
@@ -149,6 +152,7 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
 }
 
 void Subdomain::setup() {
+  synchronize();
   const uint32_t stride = pipeline_->history_stride();
   nlist_.configure(skin_, stride);
   update_walls(time_);
@@ -220,25 +224,42 @@ namespace {
 /// particles that moved farther than sqrt(limit2) (a sum of 0/1 in double:
 /// GCC 12 vectorises it, but not a floating-point max without -ffast-math,
 /// nor an integer OR of a double comparison).
-template <bool kCheck>
-double kick_drift_reset(std::size_t first, std::size_t last, double dt, double half, const double g[3],
-                        double* __restrict x, double* __restrict y, double* __restrict z, double* __restrict vx,
-                        double* __restrict vy, double* __restrict vz, double* __restrict wx, double* __restrict wy,
-                        double* __restrict wz, double* __restrict fx, double* __restrict fy, double* __restrict fz,
-                        double* __restrict tx, double* __restrict ty, double* __restrict tz,
+/// With kFinish it first does the previous step's second half kick (of
+/// half_prev, with the same forces) and its finiteness check (see
+/// kick_check), counted into `bad`: one sweep over the store per step
+/// instead of two. The arithmetic is that of the two passes, value by value.
+template <bool kCheck, bool kFinish>
+double kick_drift_reset(std::size_t first, std::size_t last, double dt, double half, double half_prev,
+                        const double g[3], double* __restrict x, double* __restrict y, double* __restrict z,
+                        double* __restrict vx, double* __restrict vy, double* __restrict vz, double* __restrict wx,
+                        double* __restrict wy, double* __restrict wz, double* __restrict fx, double* __restrict fy,
+                        double* __restrict fz, double* __restrict tx, double* __restrict ty, double* __restrict tz,
                         const double* __restrict im, const double* __restrict ii, const double* __restrict m,
                         uint32_t* __restrict contacts, const double* __restrict x0, const double* __restrict y0,
-                        const double* __restrict z0, double limit2, double limit2_far,
-                        double& far_tier) {
+                        const double* __restrict z0, double limit2, double limit2_far, double& far_tier,
+                        double& bad) {
+  constexpr double kMax = std::numeric_limits<double>::max();
   const double g0 = g[0], g1 = g[1], g2 = g[2];
-  double far = 0.0, tier = 0.0;
+  double far = 0.0, tier = 0.0, nonfinite = 0.0;
   for (std::size_t k = first; k < last; ++k) {
+    double ux = vx[k], uy = vy[k], uz = vz[k], ox = wx[k], oy = wy[k], oz = wz[k];
+    const double gx = fx[k], gy = fy[k], gz = fz[k], qx = tx[k], qy = ty[k], qz = tz[k];
+    double px = x[k], py = y[k], pz = z[k];
+    if constexpr (kFinish) {
+      const double hm = half_prev * im[k], hi = half_prev * ii[k];
+      ux += hm * gx; uy += hm * gy; uz += hm * gz;
+      ox += hi * qx; oy += hi * qy; oz += hi * qz;
+      nonfinite += (std::fabs(px + py + pz + ux + uy + uz) <= kMax) ? 0.0 : 1.0;
+    }
     const double hm = half * im[k], hi = half * ii[k];
-    vx[k] += hm * fx[k]; vy[k] += hm * fy[k]; vz[k] += hm * fz[k];
-    wx[k] += hi * tx[k]; wy[k] += hi * ty[k]; wz[k] += hi * tz[k];
-    x[k] += dt * vx[k]; y[k] += dt * vy[k]; z[k] += dt * vz[k];
+    ux += hm * gx; uy += hm * gy; uz += hm * gz;
+    ox += hi * qx; oy += hi * qy; oz += hi * qz;
+    px += dt * ux; py += dt * uy; pz += dt * uz;
+    vx[k] = ux; vy[k] = uy; vz[k] = uz;
+    wx[k] = ox; wy[k] = oy; wz[k] = oz;
+    x[k] = px; y[k] = py; z[k] = pz;
     if constexpr (kCheck) {
-      const double dx = x[k] - x0[k], dy = y[k] - y0[k], dz = z[k] - z0[k];
+      const double dx = px - x0[k], dy = py - y0[k], dz = pz - z0[k];
       const double d2 = dx * dx + dy * dy + dz * dz;
       far += (d2 > limit2) ? 1.0 : 0.0;
       tier += (d2 > limit2_far) ? 1.0 : 0.0;
@@ -248,12 +269,13 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
     contacts[k] = 0;
   }
   far_tier = tier;
+  bad = nonfinite;
   return far;
 }
 
-/// Pass 2: the second half kick, and a finiteness check that costs no
-/// branch: !(|x + y + ... | <= max) holds for inf and NaN. Returns the count
-/// of non-finite particles.
+/// Pass 2 on its own (synchronize()): the second half kick, and a finiteness
+/// check that costs no branch: !(|x + y + ... | <= max) holds for inf and
+/// NaN. Returns the count of non-finite particles.
 double kick_check(std::size_t first, std::size_t last, double half, const double* __restrict x,
                   const double* __restrict y, const double* __restrict z, double* __restrict vx,
                   double* __restrict vy, double* __restrict vz, double* __restrict wx, double* __restrict wy,
@@ -270,79 +292,113 @@ double kick_check(std::size_t first, std::size_t last, double half, const double
   }
   return bad;
 }
+
+bool any_nonzero(const std::vector<double>& v) {
+  return std::any_of(v.begin(), v.end(), [](double f) { return f != 0.0; });
+}
 }  // namespace
 
-void Subdomain::step() {
-  const std::size_t n = store_.size();
-  const double dt = dt_, half = 0.5 * dt_;
-  ParticleStore& s = store_;
-  const int nt = threads();
-  std::vector<double>& partial = partial_;
-  partial.assign(static_cast<std::size_t>(nt), 0.0);
-  std::vector<double>& tier = tier_partial_;
-  tier.assign(static_cast<std::size_t>(nt), 0.0);
-  // Pass 1 (one sweep over the store instead of the four of a textbook
-  // step: kick-drift, rebuild check, force reset; docs/performance.md).
-  const bool stale = nlist_.layout_stale(s);
-  pool_->for_range(n, [&](std::size_t first, std::size_t last, int t) {
-    auto pass = stale ? &kick_drift_reset<false> : &kick_drift_reset<true>;
-    partial[static_cast<std::size_t>(t)] =
-        pass(first, last, dt, half, gravity_, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(),
-             s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
-             s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data(), s.mass.data(), s.contacts.data(),
-             nlist_.x0(), nlist_.y0(), nlist_.z0(), nlist_.rebuild_displacement2(),
-             nlist_.far_tier_displacement2(), tier[static_cast<std::size_t>(t)]);
-  });
-  update_walls(time_ + dt);
-  if (stale || walls_force_rebuild_ ||
-      std::any_of(partial.begin(), partial.end(), [](double f) { return f != 0.0; })) {
-    walls_force_rebuild_ = false;
-    rebuild_lists();
-  } else if (std::any_of(tier.begin(), tier.end(), [](double f) { return f != 0.0; })) {
-    far_active_ = true;  // latched until the next build: far entries are screened from now on
+std::pair<std::size_t, std::size_t> Subdomain::finish_forces(int t, bool reduce, std::size_t n) {
+  if (!reduce) return pool_->range(n, t);
+  // the other threads' pair forces, then the wall contacts of this thread's
+  // particles (each wall contact touches one particle)
+  const std::size_t first = pass2_split_[static_cast<std::size_t>(t)];
+  const std::size_t last = pass2_split_[static_cast<std::size_t>(t) + 1];
+  reduce_partials(first, last);
+  ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+  ts.wall_contacts = 0;
+  ts.wall_max_ratio = 0.0;
+  wall_range(ts, first, last);
+  return {first, last};
+}
+
+void Subdomain::finish_wall_stats() {
+  last_wall_contacts_ = 0;
+  for (const auto& ts : scratch_) {
+    last_wall_contacts_ += ts.wall_contacts;
+    last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.wall_max_ratio);
   }
-  contact_forces(true);
-  // Pass 2, with the other threads' force sums folded in (one sweep, one
-  // fork/join less than a separate reduction).
+}
+
+void Subdomain::throw_nonfinite() const {
+  std::ostringstream os;
+  os << "subdomain '" << name_ << "': a particle position or velocity became non-finite at t = " << time_
+     << " s (step " << steps_ << "); the time step " << dt_ << " s is probably too large for the contact model";
+  throw RuntimeError(os.str());
+}
+
+void Subdomain::synchronize() {
+  if (!kick_pending_) return;
+  kick_pending_ = false;
+  const std::size_t n = store_.size();
+  ParticleStore& s = store_;
   const bool reduce = reduce_pending_;
   reduce_pending_ = false;
   if (reduce) reduce_split(n);
+  std::vector<double>& bad = partial_;
+  bad.assign(static_cast<std::size_t>(threads()), 0.0);
   pool_->run([&](int t) {
-    std::size_t first = 0, last = n;
-    if (reduce) {
-      // the other threads' pair forces, then the wall contacts of this
-      // thread's particles (each wall contact touches one particle)
-      first = pass2_split_[static_cast<std::size_t>(t)];
-      last = pass2_split_[static_cast<std::size_t>(t) + 1];
-      reduce_partials(first, last);
-      ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
-      ts.wall_contacts = 0;
-      ts.wall_max_ratio = 0.0;
-      wall_range(ts, first, last);
-    } else {
-      std::tie(first, last) = pool_->range(n, t);
-    }
-    partial[static_cast<std::size_t>(t)] =
-        kick_check(first, last, half, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(), s.vz.data(),
-                   s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(),
-                   s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data());
+    const auto [first, last] = finish_forces(t, reduce, n);
+    bad[static_cast<std::size_t>(t)] =
+        kick_check(first, last, pending_half_, s.x.data(), s.y.data(), s.z.data(), s.vx.data(), s.vy.data(),
+                   s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(),
+                   s.tx.data(), s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data());
   });
-  if (reduce) {
-    last_wall_contacts_ = 0;
-    for (const auto& ts : scratch_) {
-      last_wall_contacts_ += ts.wall_contacts;
-      last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.wall_max_ratio);
-    }
+  if (reduce) finish_wall_stats();
+  if (any_nonzero(bad)) throw_nonfinite();
+}
+
+void Subdomain::step_deferred() {
+  const std::size_t n = store_.size();
+  const double dt = dt_, half = 0.5 * dt_;
+  ParticleStore& s = store_;
+  const std::size_t nt = static_cast<std::size_t>(threads());
+  std::vector<double>& partial = partial_;
+  partial.assign(nt, 0.0);
+  std::vector<double>& tier = tier_partial_;
+  tier.assign(nt, 0.0);
+  std::vector<double>& bad = bad_partial_;
+  bad.assign(nt, 0.0);
+  // Pass 1 (one sweep over the store instead of the five of a textbook
+  // step: the last step's second half kick (unless synchronize() did it),
+  // this step's half kick and drift, rebuild check, force reset;
+  // docs/performance.md). With threads, the last step's force sums and
+  // wall contacts are finished first, per particle range.
+  const bool stale = nlist_.layout_stale(s);
+  const bool finish = kick_pending_;
+  const bool reduce = finish && reduce_pending_;
+  kick_pending_ = false;
+  reduce_pending_ = false;
+  if (reduce) reduce_split(n);
+  pool_->run([&](int t) {
+    const auto [first, last] = finish_forces(t, reduce, n);
+    auto pass = stale ? (finish ? &kick_drift_reset<false, true> : &kick_drift_reset<false, false>)
+                      : (finish ? &kick_drift_reset<true, true> : &kick_drift_reset<true, false>);
+    const auto q = static_cast<std::size_t>(t);
+    partial[q] = pass(first, last, dt, half, pending_half_, gravity_, s.x.data(), s.y.data(), s.z.data(),
+                      s.vx.data(), s.vy.data(), s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(),
+                      s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.inv_mass.data(),
+                      s.inv_inertia.data(), s.mass.data(), s.contacts.data(), nlist_.x0(), nlist_.y0(), nlist_.z0(),
+                      nlist_.rebuild_displacement2(), nlist_.far_tier_displacement2(), tier[q], bad[q]);
+  });
+  if (reduce) finish_wall_stats();
+  // reported as at the end of the last step, where the two-pass step found it
+  if (finish && any_nonzero(bad)) throw_nonfinite();
+  update_walls(time_ + dt);
+  if (stale || walls_force_rebuild_ || any_nonzero(partial)) {
+    walls_force_rebuild_ = false;
+    rebuild_lists();
+  } else if (any_nonzero(tier)) {
+    far_active_ = true;  // latched until the next build: far entries are screened from now on
   }
-  const bool finite = std::none_of(partial.begin(), partial.end(), [](double p) { return p != 0.0; });
+  // The forces; with threads, the other threads' sums and the wall contacts
+  // are left to the next pass 1 (or synchronize()), as is the second half
+  // kick: one fork/join and one sweep less per step.
+  contact_forces(true);
+  kick_pending_ = true;
+  pending_half_ = half;
   time_ += dt;
   ++steps_;
-  if (!finite) {
-    std::ostringstream os;
-    os << "subdomain '" << name_ << "': a particle position or velocity became non-finite at t = " << time_
-       << " s (step " << steps_ << "); the time step " << dt_ << " s is probably too large for the contact model";
-    throw RuntimeError(os.str());
-  }
 }
 
 void Subdomain::compute_forces() {
@@ -360,17 +416,19 @@ void Subdomain::compute_forces() {
 }
 
 std::vector<const std::vector<ContactRecord>*> Subdomain::contact_records() const {
+  const_cast<Subdomain*>(this)->synchronize();  // the wall contacts' records, see store()
   std::vector<const std::vector<ContactRecord>*> out;
   for (const auto& ts : scratch_) out.push_back(&ts.records);
   return out;
 }
 
 void Subdomain::contact_forces(bool defer_reduce) {
+  forces_time_ = time_;
   last_max_overlap_ratio_ = 0;
   for (auto& ts : scratch_) ts.records.clear();
   pair_forces(defer_reduce);
   if (reduce_pending_) {
-    prune_removed_walls();  // the walls' forces follow in step()'s second pass, per particle range
+    prune_removed_walls();  // the walls' forces follow in the next pass 1 or synchronize(), per particle range
   } else {
     wall_forces();
   }
@@ -387,43 +445,44 @@ void Subdomain::pair_forces(bool defer_reduce) {
     ts.max_ratio = 0.0;
   }
   if (nt == 1) {
-    pair_range(0, nlist_.near_size(), scratch_[0], direct);
-    if (far) pair_range(nlist_.near_size(), nlist_.size(), scratch_[0], direct);
+    ThreadScratch& ts = scratch_[0];
+    ts.own_lo = 0;
+    ts.own_hi = s.size();
+    pair_range(0, nlist_.near_size(), ts, direct, direct);
+    if (far) pair_range(nlist_.near_size(), nlist_.size(), ts, direct, direct);
   } else {
     // Each thread owns a fixed, contiguous range of each tier of the pair
     // list (so each list entry and its history has one writer). Thread 0 adds
-    // into the store; the others into their own arrays, over the span of
-    // particle indices their pairs touch, summed in thread order
+    // into the store. The others add into the store too for the particles
+    // that no other thread's pairs touch (thread_zones), and into their own
+    // arrays for the rest, which are summed in thread order
     // (reduce_partials): the same floating-point sums every run for a given
     // thread count.
     const std::size_t n = s.size();
     balance_pairs(nt);
+    thread_zones(far);
     pool_->run([&](int t) {
       const std::size_t q = static_cast<std::size_t>(t);
       ThreadScratch& ts = scratch_[q];
-      Accumulator acc = direct;
+      Accumulator shared = direct;
       if (t > 0) {
         if (ts.contacts.size() != n) {
           for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) v->assign(n, 0.0);
           ts.contacts.assign(n, 0);
         }
-        ts.lo = ts.span[0][0];
-        ts.hi = ts.span[0][1];
-        if (far && ts.span[1][1] > ts.span[1][0]) {
-          ts.lo = ts.hi > ts.lo ? std::min(ts.lo, ts.span[1][0]) : ts.span[1][0];
-          ts.hi = std::max(ts.hi, ts.span[1][1]);
+        for (const auto& [lo, hi] : {std::pair{ts.lo, ts.own_lo}, std::pair{ts.own_hi, ts.hi}}) {
+          const auto a = static_cast<std::ptrdiff_t>(lo), b = static_cast<std::ptrdiff_t>(hi);
+          for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) std::fill(v->begin() + a, v->begin() + b, 0.0);
+          std::fill(ts.contacts.begin() + a, ts.contacts.begin() + b, 0u);
         }
-        const auto lo = static_cast<std::ptrdiff_t>(ts.lo), hi = static_cast<std::ptrdiff_t>(ts.hi);
-        for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) std::fill(v->begin() + lo, v->begin() + hi, 0.0);
-        std::fill(ts.contacts.begin() + lo, ts.contacts.begin() + hi, 0u);
-        acc = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data(),
-               ts.contacts.data()};
+        shared = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data(),
+                  ts.contacts.data()};
       }
-      pair_range(split_[0][q], split_[0][q + 1], ts, acc);
-      if (far) pair_range(split_[1][q], split_[1][q + 1], ts, acc);
+      pair_range(split_[0][q], split_[0][q + 1], ts, direct, shared);
+      if (far) pair_range(split_[1][q], split_[1][q + 1], ts, direct, shared);
     });
     if (defer_reduce) {
-      reduce_pending_ = true;  // step() folds the sums into its second half kick
+      reduce_pending_ = true;  // folded into the next pass 1 or synchronize()
     } else {
       pool_->for_range(n, [&](std::size_t first, std::size_t last, int) { reduce_partials(first, last); });
     }
@@ -432,6 +491,45 @@ void Subdomain::pair_forces(bool defer_reduce) {
   for (const auto& ts : scratch_) {
     last_contacts_ += ts.n_contacts;
     last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.max_ratio);
+  }
+}
+
+void Subdomain::thread_zones(bool far) {
+  // Each thread's particle-index span this step: its near-tier span, widened
+  // by its far-tier span while the far tier is screened.
+  const int nt = threads();
+  for (ThreadScratch& ts : scratch_) {
+    ts.lo = ts.span[0][0];
+    ts.hi = ts.span[0][1];
+    if (far && ts.span[1][1] > ts.span[1][0]) {
+      ts.lo = ts.hi > ts.lo ? std::min(ts.lo, ts.span[1][0]) : ts.span[1][0];
+      ts.hi = std::max(ts.hi, ts.span[1][1]);
+    }
+  }
+  // A thread's own zone: the largest interval of its span that no other
+  // span meets, found by cutting away each other span in turn (cutting only
+  // shrinks the interval, so a span cut away earlier stays clear). The list
+  // is built in order of the lower particle index, so after a build in
+  // spatial order a thread's span overlaps its neighbours' only in a band one
+  // cell layer deep, and most of its forces skip the private arrays, their
+  // clearing and their sum.
+  for (int t = 1; t < nt; ++t) {
+    ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+    std::size_t a = ts.lo, b = ts.hi;
+    for (int u = 0; u < nt && a < b; ++u) {
+      const ThreadScratch& other = scratch_[static_cast<std::size_t>(u)];
+      if (u == t || other.hi <= other.lo || other.hi <= a || other.lo >= b) continue;
+      if (other.lo <= a) a = other.hi;
+      else if (other.hi >= b) b = other.lo;
+      else if (other.lo - a >= b - other.hi) b = other.lo;  // keep the larger side
+      else a = other.hi;
+    }
+    if (a < b) {
+      ts.own_lo = a;
+      ts.own_hi = b;
+    } else {
+      ts.own_lo = ts.own_hi = ts.hi;
+    }
   }
 }
 
@@ -445,8 +543,8 @@ void Subdomain::reduce_split(std::size_t n) {
   const int nt = threads();
   std::vector<std::size_t> cuts = {0, n};
   for (int t = 1; t < nt; ++t) {
-    cuts.push_back(std::min(scratch_[static_cast<std::size_t>(t)].lo, n));
-    cuts.push_back(std::min(scratch_[static_cast<std::size_t>(t)].hi, n));
+    const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
+    for (std::size_t c : {ts.lo, ts.own_lo, ts.own_hi, ts.hi}) cuts.push_back(std::min(c, n));
   }
   std::sort(cuts.begin(), cuts.end());
   cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
@@ -454,7 +552,7 @@ void Subdomain::reduce_split(std::size_t n) {
     double w = 1.0;
     for (int t = 1; t < nt; ++t) {
       const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
-      if (k >= ts.lo && k < ts.hi) w += kReduceCost;
+      if ((k >= ts.lo && k < ts.own_lo) || (k >= ts.own_hi && k < ts.hi)) w += kReduceCost;
     }
     return w;
   };
@@ -481,11 +579,13 @@ void Subdomain::reduce_partials(std::size_t first, std::size_t last) {
   ParticleStore& s = store_;
   for (int t = 1; t < threads(); ++t) {
     const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
-    const std::size_t a = std::max(first, ts.lo), b = std::min(last, ts.hi);
-    for (std::size_t k = a; k < b; ++k) {
-      s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
-      s.tx[k] += ts.tx[k]; s.ty[k] += ts.ty[k]; s.tz[k] += ts.tz[k];
-      s.contacts[k] += ts.contacts[k];
+    for (const auto& [lo, hi] : {std::pair{ts.lo, ts.own_lo}, std::pair{ts.own_hi, ts.hi}}) {
+      const std::size_t a = std::max(first, lo), b = std::min(last, hi);
+      for (std::size_t k = a; k < b; ++k) {
+        s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
+        s.tx[k] += ts.tx[k]; s.ty[k] += ts.ty[k]; s.tz[k] += ts.tz[k];
+        s.contacts[k] += ts.contacts[k];
+      }
     }
   }
 }
@@ -513,13 +613,15 @@ inline void copy_row(const double* __restrict src, double* __restrict dst, uint3
 void Subdomain::balance_pairs(int nt) {
   // Contiguous ranges of each tier of the pair list with near-equal estimated
   // cost: an entry costs 1 (the overlap screen) and a contact kContactCost
-  // more (the contact kernels and the scatter; on S1 at 50k, 8 balanced the
-  // two threads better than 4). Even entry counts leave the thread with the
+  // more (the contact kernels and the scatter). Two threads, 2026-12-01:
+  // 12 ran S2 with sd_critical_angle at 50k 4 % faster than 8 (its contacts
+  // carry a rolling kernel), S1 and the dense bed 1-2 % faster; 16 and 24
+  // were no better. Even entry counts leave the thread with the
   // dense, settled bottom of a column with most of the work. The split
   // depends only on the list and its contact flags, never on timings, so a
   // run is bit-identical for a given thread count. Recomputed every
   // kBalanceEvery steps and after each list build.
-  constexpr uint64_t kContactCost = 8;
+  constexpr uint64_t kContactCost = 12;
   constexpr std::uint64_t kBalanceEvery = 32;
   const std::size_t tiers[3] = {0, nlist_.near_size(), nlist_.size()};
   if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds() &&
@@ -541,10 +643,8 @@ void Subdomain::balance_pairs(int nt) {
       run += 1 + kContactCost * touching[e];
       while (t < nt && run * static_cast<uint64_t>(nt) >= total * static_cast<uint64_t>(t)) split[t++] = e + 1;
     }
-    // The particle-index span each thread's pairs touch: the only part of its
-    // private force arrays to clear and to sum (after a list build in spatial
-    // order, a band rather than the whole store).
-    for (int q = 1; q < nt; ++q) {
+    // The particle-index span each thread's pairs touch (thread_zones).
+    for (int q = 0; q < nt; ++q) {
       ThreadScratch& ts = scratch_[static_cast<std::size_t>(q)];
       std::size_t lo = store_.size(), hi = 0;
       for (std::size_t e = split[static_cast<std::size_t>(q)]; e < split[static_cast<std::size_t>(q) + 1]; ++e) {
@@ -558,7 +658,8 @@ void Subdomain::balance_pairs(int nt) {
   split_builds_ = nlist_.builds();
 }
 
-void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc) {
+void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& own,
+                           const Accumulator& shared) {
   const ParticleStore& s = store_;
   auto& buf = ts.ws->buf;
   const uint32_t stride = nlist_.stride();
@@ -591,6 +692,9 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   double* __restrict b_wz = buf.wz.data();
   double* __restrict b_hist = buf.history.data();
   constexpr uint32_t kBatch = ContactPipeline::kBatchSize;
+  // unsigned k - zone_lo < zone_width: k in [own_lo, own_hi)
+  const auto zone_lo = static_cast<uint32_t>(ts.own_lo);
+  const auto zone_width = static_cast<uint32_t>(ts.own_hi - ts.own_lo);
 
   std::size_t e = first;
   while (e < last) {
@@ -665,16 +769,18 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       const double fn = fn_[q];
       const double ftx = ftx_[q], fty = fty_[q], ftz = ftz_[q];
       const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
-      acc.fx[i] += fx; acc.fy[i] += fy; acc.fz[i] += fz;
-      acc.fx[j] -= fx; acc.fy[j] -= fy; acc.fz[j] -= fz;
+      const Accumulator& ai = i - zone_lo < zone_width ? own : shared;
+      const Accumulator& aj = j - zone_lo < zone_width ? own : shared;
+      ai.fx[i] += fx; ai.fy[i] += fy; ai.fz[i] += fz;
+      aj.fx[j] -= fx; aj.fy[j] -= fy; aj.fz[j] -= fz;
       // n x F_t
       const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
       const double ci = lever_i[q], cj = lever_j[q];
       const double mx = tqx_[q], my = tqy_[q], mz = tqz_[q];
-      acc.tx[i] += -ci * cx + mx; acc.ty[i] += -ci * cy + my; acc.tz[i] += -ci * cz + mz;
-      acc.tx[j] += -cj * cx - mx; acc.ty[j] += -cj * cy - my; acc.tz[j] += -cj * cz - mz;
-      ++acc.contacts[i];
-      ++acc.contacts[j];
+      ai.tx[i] += -ci * cx + mx; ai.ty[i] += -ci * cy + my; ai.tz[i] += -ci * cz + mz;
+      aj.tx[j] += -cj * cx - mx; aj.ty[j] += -cj * cy - my; aj.tz[j] += -cj * cz - mz;
+      ++ai.contacts[i];
+      ++aj.contacts[j];
       copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
                stride);
     }
@@ -710,7 +816,7 @@ void Subdomain::wall_forces() {
 void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t last) {
   // Wall contacts of the particles with index in [first, last). Each touches
   // one particle, so threads with disjoint particle ranges may run this at
-  // once (step() does, in its second pass). Wall lists are in index order.
+  // once (finish_forces() does). Wall lists are in index order.
   ParticleStore& s = store_;
   auto& buf = ts.ws->buf;
   const uint32_t stride = pipeline_->history_stride();
@@ -719,7 +825,9 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     WallNeighbors& list = wall_lists_[w];
     const WallPrimitive& wall = walls_now_[w];
-    if (!wall.active(time_)) continue;  // pruned by prune_removed_walls() / update_walls()
+    // pruned by prune_removed_walls() / update_walls(); the time of the force
+    // evaluation, as the walls' contacts may be finished in the next step
+    if (!wall.active(forces_time_)) continue;
     const auto lo = std::lower_bound(list.particle.begin(), list.particle.end(), static_cast<uint32_t>(first));
     const auto hi = std::lower_bound(lo, list.particle.end(), static_cast<uint32_t>(std::min<std::size_t>(last, UINT32_MAX)));
     const std::size_t e_first = static_cast<std::size_t>(lo - list.particle.begin());
@@ -838,6 +946,7 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
 }
 
 SubdomainStats Subdomain::stats() const {
+  const_cast<Subdomain*>(this)->synchronize();  // see store()
   SubdomainStats st;
   const ParticleStore& s = store_;
   st.particles = s.size();

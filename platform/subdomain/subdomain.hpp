@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace domel::platform {
@@ -59,8 +60,23 @@ class Subdomain {
   double coarse_grain() const { return coarse_grain_; }
   std::size_t material() const { return material_; }
   ContactPipeline& pipeline() { return *pipeline_; }
-  ParticleStore& store() { return store_; }
-  const ParticleStore& store() const { return store_; }
+  /// The particles at the end of the last step: a step left pending by
+  /// step_deferred() is finished first (synchronize()). The const overload
+  /// does so too (the pending kick is an internal deferral, not observable
+  /// state); not for concurrent use from several threads.
+  ParticleStore& store() {
+    synchronize();
+    return store_;
+  }
+  const ParticleStore& store() const {
+    const_cast<Subdomain*>(this)->synchronize();
+    return store_;
+  }
+  /// Particle count (needs no synchronisation).
+  std::size_t size() const { return store_.size(); }
+  /// Finish the last step now (see store()); throws RuntimeError when a
+  /// particle became non-finite. Cheap when nothing is pending.
+  void synchronize();
 
   /// Wire materials and walls (pairs are derived once). Call before setup().
   void set_environment(const std::vector<Material>& materials, const std::vector<PairCoefficients>& wall_pairs,
@@ -86,8 +102,20 @@ class Subdomain {
 
   /// Build neighbour lists and evaluate forces at the current state.
   void setup();
-  /// One velocity-Verlet step of dt.
-  void step();
+  /// One velocity-Verlet step of dt, complete on return.
+  void step() {
+    step_deferred();
+    synchronize();
+  }
+  /// One velocity-Verlet step of dt that leaves its second half kick (and,
+  /// with threads, the last force sums and the wall contacts) pending: the
+  /// next step does them in its first sweep over the store, which saves one
+  /// sweep and one fork/join per step (docs/performance.md). store(),
+  /// stats(), contact_records() and synchronize() finish it, so every
+  /// observer that goes through them sees the complete step; a reference to
+  /// the store kept from before does not. The run loop uses this; code that
+  /// holds on to the store across steps uses step().
+  void step_deferred();
 
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
@@ -113,7 +141,12 @@ class Subdomain {
     std::size_t n_contacts = 0;
     std::size_t wall_contacts = 0;
     double wall_max_ratio = 0;
-    std::size_t lo = 0, hi = 0;      ///< particle-index span of this thread's pairs this step (threads > 0)
+    std::size_t lo = 0, hi = 0;      ///< particle-index span of this thread's pairs this step
+    /// The part of [lo, hi) that no other thread's pairs touch this step:
+    /// forces on these particles go straight into the store (threads > 0;
+    /// own_lo == own_hi == hi when there is none). Only [lo, own_lo) and
+    /// [own_hi, hi) of the private arrays are cleared and summed.
+    std::size_t own_lo = 0, own_hi = 0;
     std::size_t span[2][2] = {{0, 0}, {0, 0}};  ///< the span per list tier (near, far)
     double max_ratio = 0;
     MeshScratch mesh;                ///< mesh walls: per-particle feature bookkeeping
@@ -138,7 +171,17 @@ class Subdomain {
   void reduce_partials(std::size_t first, std::size_t last);
   void reduce_split(std::size_t n);
   void balance_pairs(int nt);
-  void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& acc);
+  /// Forces on particles in [ts.own_lo, ts.own_hi) go to `own`, on the others to `shared`.
+  void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& own,
+                  const Accumulator& shared);
+  /// Set lo/hi and own_lo/own_hi of every thread for this step (threads > 1).
+  void thread_zones(bool far);
+  /// The part of the last force evaluation left to the integration pass,
+  /// for thread t: with `reduce`, the other threads' sums and the wall
+  /// contacts of its particle range (pass2_split_). Returns that range.
+  std::pair<std::size_t, std::size_t> finish_forces(int t, bool reduce, std::size_t n);
+  void finish_wall_stats();
+  [[noreturn]] void throw_nonfinite() const;
   void wall_forces();
   void prune_removed_walls();
   void wall_range(ThreadScratch& ts, std::size_t first, std::size_t last);
@@ -169,6 +212,10 @@ class Subdomain {
   std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
   bool reduce_pending_ = false;
+  bool kick_pending_ = false;  ///< the last step's second half kick is still to do (store())
+  double pending_half_ = 0;    ///< its half time step
+  double forces_time_ = 0;     ///< time_ at the last force evaluation (wall activity)
+  std::vector<double> bad_partial_;  ///< per-thread counts of non-finite particles
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   static constexpr std::size_t kReorderMinParticles = 5000;
   std::size_t reorder_every_ = 20;  ///< list builds between spatial re-orderings (0: never)
