@@ -40,6 +40,13 @@ struct ParticleStore {
   /// Append one particle at rest. Mass from density and radius.
   void add(std::uint64_t pid, double px, double py, double pz, double r, double density, bool fixed = false);
 
+  /// Make room for n particles in every array, so that a block of known
+  /// size (an insertion, a state file) is appended without the doubling
+  /// growth of push_back, which leaves up to half of each array unused.
+  void reserve(std::size_t n) {
+    for_each_array([n](auto& v) { v.reserve(n); });
+  }
+
   /// Remove particle k by moving the last one into its place.
   void swap_remove(std::size_t k);
 

@@ -802,6 +802,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
         const auto rows = io::read_particle_state(f);
         ParticleStore& st = sub->store();
         const double density = sim->materials[mat_index.at(mat_name)].density;
+        st.reserve(st.size() + rows.size());
         for (const auto& p : rows) {
           st.add(next_id++, p.x, p.y, p.z, p.radius, density, p.fixed);
           if (p.fixed) continue;  // a fixed particle stays at rest
@@ -837,6 +838,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
             for (int a = 0; a < 3; ++a) v[a] = block["velocity"][a].get<double>();
           const double density = sim->materials[mat_index.at(mat_name)].density;
           const bool fixed = block.value("fixed", false);
+          st.reserve(st.size() + x.size());
           for (std::size_t p = 0; p < x.size(); ++p) {
             st.add(next_id++, x[p], y[p], z[p], r[p], density, fixed);
             st.vx.back() = v[0]; st.vy.back() = v[1]; st.vz.back() = v[2];
