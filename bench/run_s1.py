@@ -64,7 +64,7 @@ CSV_FIELDS = [
     "timestamp", "code", "N_requested", "N_actual", "rep", "ok", "timed_steps", "timed_wall_s",
     "particle_steps_per_s", "process_wall_s", "process_cpu_s", "timed_cpu_s", "particle_steps_per_cpu_s",
     "load1_start", "load1_end", "mean_contacts_per_particle", "ke_translational_final_J", "neighbor_builds_total",
-    "peak_rss_bytes", "error", "log",
+    "peak_rss_bytes", "history_bytes", "error", "log",
 ]
 
 
@@ -220,6 +220,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
             row["mean_contacts_per_particle"] = 2.0 * fin["contacts"] / sd["particles"]
         row["ke_translational_final_J"] = fin.get("ke_translational_J")
         row["neighbor_builds_total"] = sd.get("neighbor_list_builds")
+        row["history_bytes"] = (sd.get("memory_bytes") or {}).get("contact_history")
     # domel has no CPU clock of its own around the timed steps: they are the last steps of the process, so
     # take the CPU time the process used in its last timed_wall_s seconds (sampled from /proc every 20 ms;
     # includes the few ms of summary writing and exit)
@@ -348,19 +349,27 @@ def print_tables(rows, sizes, have_peer, deck="S1 settle"):
     for n in sizes:
         mine = [r for r in rows if r["N_requested"] == n and r["code"] == "domel" and r.get("ok")]
         rss = stats([r.get("peak_rss_bytes") for r in mine])
+        hist = stats([float(r["history_bytes"]) for r in mine if r.get("history_bytes") not in (None, "")])
         nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), None)
         if rss and nact:
-            mem.append((float(nact), rss[0]))
+            mem.append((float(nact), rss[0], hist[0] if hist else None))
     if mem:
         print()
         print("domel peak resident memory (1 thread, median over runs; whole process: libraries, VTK, the pair list and "
-              "its contact history included); bytes per particle = slope between the sizes")
-        ml = [[str(int(nn)), "%.1f MB" % (r / 1e6), "%.0f" % (r / nn)] for nn, r in mem]
-        print_md(["N", "peak RSS", "RSS / N (bytes)"], ml)
+              "its contact history included); bytes per particle = slope between the sizes. Contact history = the "
+              "history rows of the pair and wall lists at the end of the run (summary.json memory_bytes)")
+        ml = [[str(int(nn)), "%.1f MB" % (r / 1e6), "%.0f" % (r / nn), "%.1f MB" % (h / 1e6) if h else "-"]
+              for nn, r, h in mem]
+        print_md(["N", "peak RSS", "RSS / N (bytes)", "contact history"], ml)
         if len(mem) >= 2:
-            (n1, r1), (n2, r2) = mem[0], mem[-1]
+            (n1, r1, h1), (n2, r2, h2) = mem[0], mem[-1]
             if n2 != n1:
-                print("marginal memory per particle between N = %d and %d: %.0f bytes" % (n1, n2, (r2 - r1) / (n2 - n1)))
+                marginal = (r2 - r1) / (n2 - n1)
+                print("marginal memory per particle between N = %d and %d: %.0f bytes" % (n1, n2, marginal))
+                if h1 is not None and h2 is not None:
+                    hm = (h2 - h1) / (n2 - n1)
+                    print("  of which contact history: %.0f bytes; the rest: %.0f bytes (target: <= 400 plus the "
+                          "history)" % (hm, marginal - hm))
 
     print()
     print("Per CPU-second of the timed steps (robust to time-slicing on a loaded machine): LIGGGHTS from the "

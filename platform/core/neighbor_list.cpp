@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 namespace domel::platform {
 
@@ -27,36 +26,86 @@ bool NeighborList::needs_rebuild(const ParticleStore& s) const {
   return false;
 }
 
+namespace {
+/// The live contact history of the last list, keyed by the pair's ids: the
+/// keys in row order, and an open-addressing table of row numbers (linear
+/// probing, at most 3/4 full) over them. Two flat arrays, no node per
+/// contact: 8 bytes per contact plus 5-11 for the table.
+class LiveHistory {
+ public:
+  explicit LiveHistory(std::size_t live) {
+    std::size_t cap = 16;
+    while (3 * cap < 4 * live) cap *= 2;
+    table_.assign(cap, kNone);
+    mask_ = cap - 1;
+    keys_.reserve(live);
+  }
+  /// Add the next row (rows are numbered in the order of add()).
+  void add(std::uint64_t key) {
+    std::size_t h = mix(key) & mask_;
+    while (table_[h] != kNone) h = (h + 1) & mask_;
+    table_[h] = static_cast<std::uint32_t>(keys_.size());
+    keys_.push_back(key);
+  }
+  /// The row of `key`, or kNone.
+  std::uint32_t find(std::uint64_t key) const {
+    for (std::size_t h = mix(key) & mask_; table_[h] != kNone; h = (h + 1) & mask_)
+      if (keys_[table_[h]] == key) return table_[h];
+    return kNone;
+  }
+  std::size_t size() const { return keys_.size(); }
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+
+ private:
+  static std::uint64_t mix(std::uint64_t z) {  // the splitmix64 finaliser (Steele et al. 2014)
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  std::vector<std::uint32_t> table_;
+  std::vector<std::uint64_t> keys_;
+  std::size_t mask_ = 0;
+};
+}  // namespace
+
 void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   const std::size_t n = s.size();
-  // Keep only the live history (pairs in contact, ~1-2 per particle), keyed by
-  // (id_i, id_j), and release the old list before the new one is built: the
-  // build's peak memory is then the new list plus the contacts, not two lists
-  // (docs/performance.md, memory).
+  // Keep only the live history (pairs in contact, ~1-6 per particle), keyed by
+  // (id_i, id_j), moved to the front of the history array. The list's arrays
+  // are cleared but keep their capacity: the new list, about the size of the
+  // old, is built into them and the live rows are moved to their new entries
+  // in place, so a rebuild neither allocates the list anew nor copies its
+  // history (either raised the peak resident memory by 50-190 bytes per
+  // particle; docs/performance.md, memory). Transient: the keys of the live
+  // contacts and their table, the cell index and the entries of the threads
+  // other than the first.
   std::size_t live = 0;
   for (std::size_t k = 0; k < i.size(); ++k) live += touching[k] ? 1 : 0;
-  std::unordered_map<std::uint64_t, std::size_t> old;
-  old.reserve(live);
-  std::vector<double> old_history;
-  old_history.reserve(live * stride_);
-  for (std::size_t k = 0; k < i.size(); ++k) {
+  LiveHistory old(live);
+  for (std::size_t k = 0, row = 0; k < i.size(); ++k) {
     if (!touching[k]) continue;
-    old.emplace(pair_key(built_ids_[i[k]], built_ids_[j[k]]), old_history.size() / std::max<uint32_t>(stride_, 1));
-    old_history.insert(old_history.end(), history.begin() + static_cast<std::ptrdiff_t>(k * stride_),
-                       history.begin() + static_cast<std::ptrdiff_t>((k + 1) * stride_));
+    old.add(pair_key(built_ids_[i[k]], built_ids_[j[k]]));
+    std::copy_n(history.begin() + static_cast<std::ptrdiff_t>(k * stride_), stride_,
+                history.begin() + static_cast<std::ptrdiff_t>(row * stride_));  // row <= k: front to back is safe
+    ++row;
   }
-  const std::size_t previous = i.size();
-  for (auto* v : {&i, &j}) std::vector<uint32_t>().swap(*v);
-  std::vector<double>().swap(history);
-  std::vector<uint8_t>().swap(touching);
+  history.resize(live * stride_);
+  const std::size_t previous = i.size(), previous_far = i.size() - near_size_;
+  i.clear();
+  j.clear();
+  touching.clear();
   // Tiers (see near_size()): near entries go to i/j, far ones to fi/fj, each in
-  // build order; far is appended after the cell loop.
+  // build order; far is appended after the cell loop. The first thread's near
+  // entries are written straight into the list's arrays.
   const double h = near_gap();
   struct Part {
     std::vector<uint32_t> i, j, fi, fj;
+    std::size_t near = 0, far = 0;  ///< entries of the counting pass
   };
   const int nt = pool != nullptr && n >= 4096 ? pool->size() : 1;
   std::vector<Part> parts(static_cast<std::size_t>(nt));
+  parts[0].i = std::move(i);
+  parts[0].j = std::move(j);
 
   if (n > 0) {
     double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -127,60 +176,81 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     // range appends to its own near and far arrays, and the ranges are joined
     // in order, so the list is exactly the one-thread list for any thread
     // count (entries in order of a, then of the cell scan).
-    // size from the last build (+5 %) rather than growing by doubling
-    const std::size_t expect = (previous > 0 ? previous + previous / 20 : 4 * n) / static_cast<std::size_t>(nt);
-    auto scan = [&](std::size_t a_first, std::size_t a_last, Part& part) {
-    part.i.reserve(expect);
-    part.j.reserve(expect);
-    for (std::size_t a = a_first; a < a_last; ++a) {
-      int c[3];
-      cell_of(a, c);
-      for (int dz = -1; dz <= 1; ++dz) {
-        const int cz = c[2] + dz;
-        if (cz < 0 || cz >= dim[2]) continue;
-        for (int dy = -1; dy <= 1; ++dy) {
-          const int cy = c[1] + dy;
-          if (cy < 0 || cy >= dim[1]) continue;
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int cx = c[0] + dx;
-            if (cx < 0 || cx >= dim[0]) continue;
-            const std::size_t cc = (static_cast<std::size_t>(cz) * dim[1] + cy) * dim[0] + cx;
-            for (uint32_t q = start[cc]; q < start[cc + 1]; ++q) {
-              const uint32_t b = order[q];
-              if (b <= a) continue;
-              if ((s.flags[a] & s.flags[b] & ParticleStore::kFixed) != 0) continue;  // two fixed: never interact
-              const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
-              const double cut = s.radius[a] + s.radius[b] + skin_;
-              const double d2 = ddx * ddx + ddy * ddy + ddz * ddz;
-              if (d2 < cut * cut) {
-                const bool near = std::sqrt(d2) - s.radius[a] - s.radius[b] < h;
-                auto& ti = near ? part.i : part.fi;
-                auto& tj = near ? part.j : part.fj;
-                if (s.id[a] < s.id[b]) { ti.push_back(static_cast<uint32_t>(a)); tj.push_back(b); }
-                else { ti.push_back(b); tj.push_back(static_cast<uint32_t>(a)); }
+    // visit(a, b, near) for each pair within the cut-off, b > a.
+    auto for_each_pair = [&](std::size_t a_first, std::size_t a_last, auto&& visit) {
+      for (std::size_t a = a_first; a < a_last; ++a) {
+        int c[3];
+        cell_of(a, c);
+        for (int dz = -1; dz <= 1; ++dz) {
+          const int cz = c[2] + dz;
+          if (cz < 0 || cz >= dim[2]) continue;
+          for (int dy = -1; dy <= 1; ++dy) {
+            const int cy = c[1] + dy;
+            if (cy < 0 || cy >= dim[1]) continue;
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int cx = c[0] + dx;
+              if (cx < 0 || cx >= dim[0]) continue;
+              const std::size_t cc = (static_cast<std::size_t>(cz) * dim[1] + cy) * dim[0] + cx;
+              for (uint32_t q = start[cc]; q < start[cc + 1]; ++q) {
+                const uint32_t b = order[q];
+                if (b <= a) continue;
+                if ((s.flags[a] & s.flags[b] & ParticleStore::kFixed) != 0) continue;  // two fixed: never interact
+                const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
+                const double cut = s.radius[a] + s.radius[b] + skin_;
+                const double d2 = ddx * ddx + ddy * ddy + ddz * ddz;
+                if (d2 < cut * cut) visit(a, b, std::sqrt(d2) - s.radius[a] - s.radius[b] < h);
               }
             }
           }
         }
       }
-    }
     };
-    if (nt == 1) {
-      scan(0, n, parts[0]);
-    } else {
-      pool->for_range(n, [&](std::size_t first, std::size_t last, int t) {
-        scan(first, last, parts[static_cast<std::size_t>(t)]);
+    auto per_range = [&](auto&& body) {
+      if (nt == 1) body(std::size_t{0}, n, 0);
+      else pool->for_range(n, body);
+    };
+    // Capacity: the last build's size + 5 %, all of it in the first thread's
+    // arrays (they become the list), and the last far tier's + 5 % per
+    // thread for the far entries. The first build counts first. So no array
+    // grows by doubling, which would leave up to half of it unused at the
+    // peak.
+    std::size_t expect = previous + previous / 20;
+    std::size_t expect_far = (previous_far + previous_far / 20) / static_cast<std::size_t>(nt);
+    const bool first_build = previous == 0;
+    if (first_build) {
+      per_range([&](std::size_t first, std::size_t last, int t) {
+        Part& part = parts[static_cast<std::size_t>(t)];
+        for_each_pair(first, last, [&part](std::size_t, uint32_t, bool near) { ++(near ? part.near : part.far); });
       });
+      for (const Part& p : parts) expect += p.near + p.far;
     }
+    per_range([&](std::size_t first, std::size_t last, int t) {
+      Part& part = parts[static_cast<std::size_t>(t)];
+      const std::size_t want = t == 0 ? expect : first_build ? part.near : expect / static_cast<std::size_t>(nt);
+      const std::size_t want_far = first_build ? part.far : expect_far;
+      part.i.reserve(want);
+      part.j.reserve(want);
+      part.fi.reserve(want_far);
+      part.fj.reserve(want_far);
+      for_each_pair(first, last, [&](std::size_t a, uint32_t b, bool near) {
+        auto& ti = near ? part.i : part.fi;
+        auto& tj = near ? part.j : part.fj;
+        if (s.id[a] < s.id[b]) { ti.push_back(static_cast<uint32_t>(a)); tj.push_back(b); }
+        else { ti.push_back(b); tj.push_back(static_cast<uint32_t>(a)); }
+      });
+    });
   }
   std::size_t near_total = 0, total = 0;
   for (const Part& p : parts) {
     near_total += p.i.size();
     total += p.i.size() + p.fi.size();
   }
-  i.reserve(total);
+  i = std::move(parts[0].i);
+  j = std::move(parts[0].j);
+  i.reserve(total);  // no-op unless the list outgrew the estimate
   j.reserve(total);
-  for (Part& p : parts) {
+  for (std::size_t t = 1; t < parts.size(); ++t) {
+    Part& p = parts[t];
     i.insert(i.end(), p.i.begin(), p.i.end());
     j.insert(j.end(), p.j.begin(), p.j.end());
     std::vector<uint32_t>().swap(p.i);
@@ -193,22 +263,55 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     std::vector<uint32_t>().swap(p.fi);
     std::vector<uint32_t>().swap(p.fj);
   }
-  history.assign(i.size() * stride_, 0.0);
+  // history and flags in their kept capacity, with 5 % headroom when they
+  // grow (reserve() keeps the live rows at the front)
+  const std::size_t rows = i.size() * stride_;
+  if (history.capacity() < rows) history.reserve(rows + rows / 20);
+  if (touching.capacity() < i.size()) touching.reserve(i.size() + i.size() / 20);
+  history.resize(std::max(rows, live * stride_));
   touching.assign(i.size(), 0);
-  if (!old.empty() && stride_ > 0) {
-    // look-ups in the (now read-only) map, each entry written by one thread
+  if (live > 0 && stride_ > 0) {
+    // The new entry of each live row (look-ups in the now read-only table;
+    // each entry and each row is written by one thread)...
+    constexpr std::uint32_t kNone = LiveHistory::kNone;
+    std::vector<std::uint32_t> dest(live, kNone);
     auto carry = [&](std::size_t first, std::size_t last) {
       for (std::size_t k = first; k < last; ++k) {
-        auto it = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
-        if (it == old.end()) continue;
-        std::copy_n(old_history.begin() + static_cast<std::ptrdiff_t>(it->second * stride_), stride_,
-                    history.begin() + static_cast<std::ptrdiff_t>(k * stride_));
+        const std::uint32_t row = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
+        if (row == kNone) continue;
+        dest[row] = static_cast<std::uint32_t>(k);
         touching[k] = 1;
       }
     };
     if (nt == 1) carry(0, i.size());
     else pool->for_range(i.size(), [&](std::size_t first, std::size_t last, int) { carry(first, last); });
+    // ...then each row moved there in place, following chains: a row whose
+    // place still holds an unmoved live row swaps it out and carries it on.
+    // Rows of contacts that left the list (a deleted particle) are dropped.
+    std::vector<double> carried(stride_);
+    double* const hist = history.data();
+    for (std::size_t r = 0; r < live; ++r) {
+      if (dest[r] == kNone) continue;
+      std::copy_n(hist + r * stride_, stride_, carried.data());
+      std::size_t at = dest[r];
+      dest[r] = kNone;
+      while (at < live && dest[at] != kNone) {
+        std::swap_ranges(carried.begin(), carried.end(), hist + at * stride_);
+        const std::size_t next = dest[at];
+        dest[at] = kNone;
+        at = next;
+      }
+      std::copy_n(carried.data(), stride_, hist + at * stride_);
+    }
   }
+  // every other entry starts with zero history
+  history.resize(rows);
+  auto zero = [&](std::size_t first, std::size_t last) {
+    for (std::size_t k = first; k < last; ++k)
+      if (!touching[k]) std::fill_n(history.begin() + static_cast<std::ptrdiff_t>(k * stride_), stride_, 0.0);
+  };
+  if (nt == 1) zero(0, i.size());
+  else pool->for_range(i.size(), [&](std::size_t first, std::size_t last, int) { zero(first, last); });
   x0_ = s.x; y0_ = s.y; z0_ = s.z;
   built_ids_ = s.id;
   built_size_ = n;

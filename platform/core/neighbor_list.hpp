@@ -54,6 +54,14 @@ class NeighborList {
   /// scan over particles runs in parallel (the same list as on one thread).
   void build(const ParticleStore& s, ThreadPool* pool = nullptr);
   std::size_t size() const { return i.size(); }
+  /// Bytes held (capacity): the contact history, and everything else (the
+  /// pair indices, the contact flags, the positions and ids of the last build).
+  std::size_t history_bytes() const { return history.capacity() * sizeof(double); }
+  std::size_t bytes_without_history() const {
+    return (i.capacity() + j.capacity()) * sizeof(uint32_t) + touching.capacity() +
+           (x0_.capacity() + y0_.capacity() + z0_.capacity()) * sizeof(double) +
+           built_ids_.capacity() * sizeof(std::uint64_t);
+  }
   std::size_t builds() const { return builds_; }
 
   std::vector<uint32_t> i, j;      ///< particle indices, id[i] < id[j]

@@ -71,6 +71,17 @@ struct ParticleStore {
     f(fx); f(fy); f(fz); f(tx); f(ty); f(tz);
     f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts); f(flags);
   }
+  template <class F>
+  void for_each_array(F&& f) const {
+    const_cast<ParticleStore*>(this)->for_each_array([&f](const auto& v) { f(v); });
+  }
+
+  /// Bytes held by the arrays (their capacity).
+  std::size_t bytes() const {
+    std::size_t b = 0;
+    for_each_array([&b](const auto& v) { b += v.capacity() * sizeof(v[0]); });
+    return b;
+  }
 };
 
 }  // namespace domel::platform

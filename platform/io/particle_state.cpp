@@ -60,10 +60,28 @@ void write_particle_state(const std::filesystem::path& path, const ParticleStore
   write_file_atomically(path, format_particle_state(store, subdomain, time, coarse_grain));
 }
 
+std::size_t count_lines(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::size_t lines = 0;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    const auto got = static_cast<std::size_t>(in.gcount());
+    for (std::size_t k = 0; k < got; ++k) lines += buf[k] == '\n' ? 1 : 0;
+  }
+  return lines + 1;  // a last line without a newline
+}
+
 std::vector<ParticleStateRow> read_particle_state(const std::filesystem::path& path) {
+  std::vector<ParticleStateRow> rows;
+  for_each_particle_state_row(path, [&rows](const ParticleStateRow& p) { rows.push_back(p); });
+  return rows;
+}
+
+std::size_t for_each_particle_state_row(const std::filesystem::path& path,
+                                        const std::function<void(const ParticleStateRow&)>& visit) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open the particle state file");
-  std::vector<ParticleStateRow> rows;
+  std::size_t rows = 0;
   std::string raw;
   std::size_t line = 0;
   bool header = false;
@@ -105,7 +123,8 @@ std::vector<ParticleStateRow> read_particle_state(const std::filesystem::path& p
     if (!(p.radius > 0)) fail(path, line, "expected a radius > 0 in column 5", text);
     if (v[11] != 0 && v[11] != 1) fail(path, line, "expected fixed = 0 or 1 in column 12", text);
     p.fixed = v[11] == 1;
-    rows.push_back(p);
+    visit(p);
+    ++rows;
   }
   if (in.bad()) throw std::runtime_error(path.string() + ": read error");
   if (!header) fail(path, line, std::string("expected the header '") + kHeader + "'", "end of file");

@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -45,5 +46,13 @@ void write_particle_state(const std::filesystem::path& path, const ParticleStore
 /// header, a wrong column count, a number that does not parse or is not
 /// finite, a radius <= 0, a fixed flag other than 0/1.
 std::vector<ParticleStateRow> read_particle_state(const std::filesystem::path& path);
+
+/// The number of lines of a file (an upper bound of its particle rows).
+std::size_t count_lines(const std::filesystem::path& path);
+
+/// The same checks, streaming: visit(row) for each particle in file order,
+/// with no copy of the whole file in memory. Returns the number of rows.
+std::size_t for_each_particle_state_row(const std::filesystem::path& path,
+                                        const std::function<void(const ParticleStateRow&)>& visit);
 
 }  // namespace domel::platform::io

@@ -258,6 +258,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
     const auto& sd = subdomains[k];
     const SubdomainStats st = sd->stats();
+    const MemoryUse mem = sd->memory_use();
     sds.push_back({{"name", sd->name()},
                    {"coarse_grain", sd->coarse_grain()},
                    {"particles", st.particles},
@@ -268,6 +269,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                    {"stability_limit_s", time_steps[k].critical},
                    {"steps", sd->steps()},
                    {"neighbor_list_builds", sd->neighbor_builds()},
+                   {"memory_bytes", {{"particles", mem.particles},
+                                     {"neighbor_lists", mem.neighbor_lists},
+                                     {"contact_history", mem.contact_history},
+                                     {"thread_force_arrays", mem.threads}}},
                    {"final", {{"ke_translational_J", st.kinetic_translational},
                               {"ke_rotational_J", st.kinetic_rotational},
                               {"mean_angular_speed", st.mean_angular_speed},

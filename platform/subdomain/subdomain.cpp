@@ -945,6 +945,22 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
   ts.wall_max_ratio = std::max(ts.wall_max_ratio, max_ratio);
 }
 
+MemoryUse Subdomain::memory_use() const {
+  MemoryUse m;
+  m.particles = store_.bytes();
+  m.neighbor_lists = nlist_.bytes_without_history();
+  m.contact_history = nlist_.history_bytes();
+  for (const WallNeighbors& w : wall_lists_) {
+    m.neighbor_lists += (w.particle.capacity() + w.triangle.capacity()) * sizeof(uint32_t) +
+                        w.particle_id.capacity() * sizeof(std::uint64_t) + w.touching.capacity();
+    m.contact_history += w.history.capacity() * sizeof(double);
+  }
+  for (const ThreadScratch& ts : scratch_)
+    m.threads += (ts.fx.capacity() + ts.fy.capacity() + ts.fz.capacity() + ts.tx.capacity() + ts.ty.capacity() +
+                  ts.tz.capacity()) * sizeof(double) + ts.contacts.capacity() * sizeof(uint32_t);
+  return m;
+}
+
 SubdomainStats Subdomain::stats() const {
   const_cast<Subdomain*>(this)->synchronize();  // see store()
   SubdomainStats st;

@@ -43,6 +43,15 @@ struct SubdomainStats {
   double max_overlap_ratio = 0;      ///< max delta / (mean diameter of the pair), walls: delta / d
 };
 
+/// Bytes held by a subdomain's per-particle and per-contact arrays (their
+/// capacity), for the run summary and the memory benchmark.
+struct MemoryUse {
+  std::size_t particles = 0;        ///< the particle store
+  std::size_t neighbor_lists = 0;   ///< pair and wall lists without their history
+  std::size_t contact_history = 0;  ///< per-entry history rows of the pair and wall lists
+  std::size_t threads = 0;          ///< the other threads' force arrays
+};
+
 struct TimeStepReport {
   double rayleigh = 0;       ///< Rayleigh time of the smallest particle [s]
   double contact_time = 0;   ///< shortest simulated collision at the impact velocity [s]
@@ -128,6 +137,7 @@ class Subdomain {
   std::vector<const std::vector<ContactRecord>*> contact_records() const;
   std::size_t neighbor_builds() const { return nlist_.builds(); }
   SubdomainStats stats() const;
+  MemoryUse memory_use() const;
 
  private:
   /// One thread's batch workspace, batch bookkeeping and force accumulators.

@@ -6,11 +6,13 @@
 // pair ids across rebuilds and re-ordering of the store.
 #include "core/neighbor_list.hpp"
 #include "core/error.hpp"
+#include "core/thread_pool.hpp"
 #include "geometry/wall_neighbors.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <random>
 #include <set>
 
@@ -168,6 +170,50 @@ TEST(NeighborList, HistorySurvivesRebuildAndReordering) {
     for (int c = 0; c < 3; ++c) EXPECT_EQ(nl.history[k * 3 + c], it->second + c);
   }
   EXPECT_EQ(carried, expected.size());
+}
+
+TEST(NeighborList, HistoryOfRemovedParticlesIsDroppedAndTheRestCarried) {
+  // Every pair live, a history row that encodes its ids; then every 7th
+  // particle removed and the rest shuffled: the build moves the surviving
+  // rows to their new entries in place (chains of swaps), drops the rows of
+  // pairs with a removed particle, and zeroes every new entry. Threaded and
+  // serial builds must agree.
+  for (int threads : {1, 2}) {
+    ParticleStore s = cloud(5000, 21);  // >= 4096: the threaded scan and carry run
+    NeighborList nl;
+    nl.configure(0.0008, 3);
+    ThreadPool pool(threads);
+    nl.build(s, &pool);
+    std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
+    for (std::size_t k = 0; k < nl.size(); ++k) {
+      const double tag = static_cast<double>(s.id[nl.i[k]] * 100000 + s.id[nl.j[k]]);
+      nl.touching[k] = 1;
+      for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
+      expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
+    }
+    std::vector<std::uint8_t> remove(s.size(), 0);
+    for (std::size_t k = 0; k < s.size(); k += 7) remove[k] = 1;
+    s.remove_marked(remove);
+    // a shuffle: k -> 7919 k mod n is a permutation (7919 is prime and does not divide n)
+    std::vector<std::uint32_t> order(s.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>((k * 7919) % order.size());
+    ASSERT_EQ(std::set<std::uint32_t>(order.begin(), order.end()).size(), order.size());
+    s.permute(order);
+    nl.build(s, &pool);
+    std::size_t carried = 0;
+    for (std::size_t k = 0; k < nl.size(); ++k) {
+      auto it = expected.find({s.id[nl.i[k]], s.id[nl.j[k]]});
+      ASSERT_TRUE(it != expected.end()) << "a pair that was not in the list before";  // nothing moved
+      ++carried;
+      ASSERT_EQ(nl.touching[k], 1);
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(nl.history[k * 3 + c], it->second + c) << threads << " threads, entry " << k;
+    }
+    std::size_t surviving = 0;
+    std::set<std::uint64_t> alive(s.id.begin(), s.id.end());
+    for (const auto& [key, tag] : expected) surviving += alive.count(key.first) && alive.count(key.second) ? 1 : 0;
+    EXPECT_EQ(carried, surviving) << threads << " threads";
+    EXPECT_LT(surviving, expected.size());  // some rows were dropped
+  }
 }
 
 TEST(WallNeighbors, HistoryFollowsParticleIdsAcrossReordering) {
