@@ -722,7 +722,7 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       const uint32_t i = li[le], j = lj[le];
       const double ri = pr[i], rj = pr[j];
       const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
-      const double rsum = ri + rj;
+      const double rsum = ri + rj, inv_rsum = 1.0 / rsum;
       const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
       const double inv = 1.0 / dist;
       const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
@@ -743,7 +743,7 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       b_nx[q] = nx; b_ny[q] = ny; b_nz[q] = nz;
       b_ri[q] = ri;
       b_rj[q] = rj;
-      b_reff[q] = ri * rj / rsum;
+      b_reff[q] = ri * rj * inv_rsum;  // one division for R* and the overlap ratio
       b_meff[q] = pm[i] * pm[j] / (pm[i] + pm[j]);
       b_vn[q] = -vdotn;
       b_vtx[q] = rx - vdotn * nx; b_vty[q] = ry - vdotn * ny; b_vtz[q] = rz - vdotn * nz;
@@ -753,7 +753,7 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       touching[le] = 1;
       lever_i[q] = ci;
       lever_j[q] = cj;
-      max_ratio = std::max(max_ratio, delta / rsum);
+      max_ratio = std::max(max_ratio, delta * inv_rsum);
     }
     pipeline_->evaluate(*ts.ws, self_pair_, dt_, c);
     // Scatter: forces and torques onto both particles, history back to the list.

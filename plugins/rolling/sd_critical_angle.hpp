@@ -89,7 +89,7 @@ class SdCriticalAngle {
         const Vec3 w = rolling_velocity(b.wx[c], b.wy[c], b.wz[c], b.nx[c], b.ny[c], b.nz[c]);
         double m0 = -k * th[0], m1 = -k * th[1], m2 = -k * th[2];
         const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
-        const double scale = m_ref / ms;  // ms > m_ref >= 0
+        const double scale = m_ref / ms;  // ms^2 > m_ref^2 >= 0, so ms > 0
         m0 *= scale; m1 *= scale; m2 *= scale;
         if (k > 0.0) { th[0] = -m0 / k; th[1] = -m1 / k; th[2] = -m2 / k; }
         else { th[0] = th[1] = th[2] = 0.0; }
@@ -131,16 +131,19 @@ class SdCriticalAngle {
       const double k = p.k, eta = p.eta, m_ref = p.m_ref;
       const double n0 = nx[c], n1 = ny[c], n2 = nz[c];
       const Vec3 w = rolling_velocity(wx[c], wy[c], wz[c], n0, n1, n2);
-      // rotate the stored angle into the current tangent plane, keeping its length
-      const double len0 = std::sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+      // rotate the stored angle into the current tangent plane, keeping its
+      // length: scaled by |theta| / |theta projected|, one square root of
+      // the ratio of the squares instead of two (and the cap compared in
+      // squares): the kernel's square roots were most of its time
+      const double len0sq = th[0] * th[0] + th[1] * th[1] + th[2] * th[2];
       const double proj = th[0] * n0 + th[1] * n1 + th[2] * n2;
       double t0 = th[0] - proj * n0, t1 = th[1] - proj * n1, t2 = th[2] - proj * n2;
-      const double len1 = std::sqrt(t0 * t0 + t1 * t1 + t2 * t2);
-      const double keep = len1 > 0.0 ? len0 / len1 : 1.0;
+      const double len1sq = t0 * t0 + t1 * t1 + t2 * t2;
+      const double keep = len1sq > 0.0 ? std::sqrt(len0sq / len1sq) : 1.0;
       t0 = t0 * keep + w.x * dt; t1 = t1 * keep + w.y * dt; t2 = t2 * keep + w.z * dt;
       const double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
-      const double ms = std::sqrt(m0 * m0 + m1 * m1 + m2 * m2);
-      const double flag = ms > m_ref ? 1.0 : 0.0;  // above the cap: redone in the second pass
+      const double ms_sq = m0 * m0 + m1 * m1 + m2 * m2;
+      const double flag = ms_sq > m_ref * m_ref ? 1.0 : 0.0;  // above the cap: redone in the second pass
       yield[c] = flag;
       yields += flag;
       const double elastic = 1.0 - flag;
