@@ -237,6 +237,22 @@ TEST(WallNeighbors, HistoryFollowsParticleIdsAcrossReordering) {
   }
 }
 
+TEST(WallNeighbors, FixedParticlesAreNotWallCandidates) {
+  // A fixed particle never moves, so walls leave it out (as two fixed
+  // particles never interact): a fixed floor laid across a container's wall
+  // would otherwise count as deep "contacts" with it.
+  ParticleStore s;
+  s.add(1, 0.0, 0.0, 0.0101, 0.001, 2500);        // free, 0.1 mm above touching the plane
+  s.add(2, 0.01, 0.0, 0.0101, 0.001, 2500, true);  // fixed, the same height
+  s.add(3, 0.02, 0.0, 0.0, 0.001, 2500, true);     // fixed, 10 diameters "into" the plane
+  WallPrimitive floor;
+  floor.p[2] = 0.01;  // plane z = 0.01, normal +z
+  WallNeighbors wl;
+  wl.build(s, floor, 0.002, 3);
+  ASSERT_EQ(wl.particle.size(), 1u);
+  EXPECT_EQ(s.id[wl.particle[0]], 1u);
+}
+
 TEST(Suggest, DidYouMeanOrFullList) {
   EXPECT_EQ(suggest("hertzz", {"hertz", "linear"}), "did you mean 'hertz'?");
   EXPECT_EQ(suggest("spring", {"linear", "hertz"}), "valid: hertz, linear");
