@@ -106,6 +106,11 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   std::vector<Part> parts(static_cast<std::size_t>(nt));
   parts[0].i = std::move(i);
   parts[0].j = std::move(j);
+  // body(first, last, thread) over [0, count), split over the threads
+  auto in_ranges = [&](std::size_t count, auto&& body) {
+    if (nt == 1) body(std::size_t{0}, count, 0);
+    else pool->for_range(count, body);
+  };
 
   if (n > 0) {
     double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
@@ -205,10 +210,6 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
         }
       }
     };
-    auto per_range = [&](auto&& body) {
-      if (nt == 1) body(std::size_t{0}, n, 0);
-      else pool->for_range(n, body);
-    };
     // Capacity: the last build's size + 5 %, all of it in the first thread's
     // arrays (they become the list), and the last far tier's + 5 % per
     // thread for the far entries. The first build counts first. So no array
@@ -218,13 +219,13 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     std::size_t expect_far = (previous_far + previous_far / 20) / static_cast<std::size_t>(nt);
     const bool first_build = previous == 0;
     if (first_build) {
-      per_range([&](std::size_t first, std::size_t last, int t) {
+      in_ranges(n, [&](std::size_t first, std::size_t last, int t) {
         Part& part = parts[static_cast<std::size_t>(t)];
         for_each_pair(first, last, [&part](std::size_t, uint32_t, bool near) { ++(near ? part.near : part.far); });
       });
       for (const Part& p : parts) expect += p.near + p.far;
     }
-    per_range([&](std::size_t first, std::size_t last, int t) {
+    in_ranges(n, [&](std::size_t first, std::size_t last, int t) {
       Part& part = parts[static_cast<std::size_t>(t)];
       const std::size_t want = t == 0 ? expect : first_build ? part.near : expect / static_cast<std::size_t>(nt);
       const std::size_t want_far = first_build ? part.far : expect_far;
@@ -275,16 +276,14 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     // each entry and each row is written by one thread)...
     constexpr std::uint32_t kNone = LiveHistory::kNone;
     std::vector<std::uint32_t> dest(live, kNone);
-    auto carry = [&](std::size_t first, std::size_t last) {
+    in_ranges(i.size(), [&](std::size_t first, std::size_t last, int) {
       for (std::size_t k = first; k < last; ++k) {
         const std::uint32_t row = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
         if (row == kNone) continue;
         dest[row] = static_cast<std::uint32_t>(k);
         touching[k] = 1;
       }
-    };
-    if (nt == 1) carry(0, i.size());
-    else pool->for_range(i.size(), [&](std::size_t first, std::size_t last, int) { carry(first, last); });
+    });
     // ...then each row moved there in place, following chains: a row whose
     // place still holds an unmoved live row swaps it out and carries it on.
     // Rows of contacts that left the list (a deleted particle) are dropped.
@@ -306,12 +305,10 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   }
   // every other entry starts with zero history
   history.resize(rows);
-  auto zero = [&](std::size_t first, std::size_t last) {
+  in_ranges(i.size(), [&](std::size_t first, std::size_t last, int) {
     for (std::size_t k = first; k < last; ++k)
       if (!touching[k]) std::fill_n(history.begin() + static_cast<std::ptrdiff_t>(k * stride_), stride_, 0.0);
-  };
-  if (nt == 1) zero(0, i.size());
-  else pool->for_range(i.size(), [&](std::size_t first, std::size_t last, int) { zero(first, last); });
+  });
   x0_ = s.x; y0_ = s.y; z0_ = s.z;
   built_ids_ = s.id;
   built_size_ = n;

@@ -23,6 +23,12 @@ class WallNeighbors {
   void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active = true);
   /// Drop every candidate and its history (a wall that is removed or not yet active).
   void clear();
+  /// Bytes held (capacity): the history rows, and everything else.
+  std::size_t history_bytes() const { return history.capacity() * sizeof(double); }
+  std::size_t bytes_without_history() const {
+    return (particle.capacity() + triangle.capacity()) * sizeof(uint32_t) +
+           particle_id.capacity() * sizeof(std::uint64_t) + touching.capacity();
+  }
   std::vector<uint32_t> particle;      ///< particle indices at this build (ascending)
   std::vector<std::uint64_t> particle_id;  ///< their ids (history is carried over by id)
   std::vector<uint32_t> triangle;      ///< mesh walls: the candidate triangle of each entry

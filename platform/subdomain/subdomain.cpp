@@ -228,6 +228,12 @@ namespace {
 /// half_prev, with the same forces) and its finiteness check (see
 /// kick_check), counted into `bad`: one sweep over the store per step
 /// instead of two. The arithmetic is that of the two passes, value by value.
+/// 1 for a particle whose position or velocity is inf or NaN, else 0, with
+/// no branch: !(|x + y + ...| <= max) holds for inf and NaN.
+inline double nonfinite(double sum_of_coordinates) {
+  return std::fabs(sum_of_coordinates) <= std::numeric_limits<double>::max() ? 0.0 : 1.0;
+}
+
 template <bool kCheck, bool kFinish>
 double kick_drift_reset(std::size_t first, std::size_t last, double dt, double half, double half_prev,
                         const double g[3], double* __restrict x, double* __restrict y, double* __restrict z,
@@ -238,9 +244,8 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
                         uint32_t* __restrict contacts, const double* __restrict x0, const double* __restrict y0,
                         const double* __restrict z0, double limit2, double limit2_far, double& far_tier,
                         double& bad) {
-  constexpr double kMax = std::numeric_limits<double>::max();
   const double g0 = g[0], g1 = g[1], g2 = g[2];
-  double far = 0.0, tier = 0.0, nonfinite = 0.0;
+  double far = 0.0, tier = 0.0, bad_count = 0.0;
   for (std::size_t k = first; k < last; ++k) {
     double ux = vx[k], uy = vy[k], uz = vz[k], ox = wx[k], oy = wy[k], oz = wz[k];
     const double gx = fx[k], gy = fy[k], gz = fz[k], qx = tx[k], qy = ty[k], qz = tz[k];
@@ -249,7 +254,7 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
       const double hm = half_prev * im[k], hi = half_prev * ii[k];
       ux += hm * gx; uy += hm * gy; uz += hm * gz;
       ox += hi * qx; oy += hi * qy; oz += hi * qz;
-      nonfinite += (std::fabs(px + py + pz + ux + uy + uz) <= kMax) ? 0.0 : 1.0;
+      bad_count += nonfinite(px + py + pz + ux + uy + uz);
     }
     const double hm = half * im[k], hi = half * ii[k];
     ux += hm * gx; uy += hm * gy; uz += hm * gz;
@@ -269,26 +274,24 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
     contacts[k] = 0;
   }
   far_tier = tier;
-  bad = nonfinite;
+  bad = bad_count;
   return far;
 }
 
-/// Pass 2 on its own (synchronize()): the second half kick, and a finiteness
-/// check that costs no branch: !(|x + y + ... | <= max) holds for inf and
-/// NaN. Returns the count of non-finite particles.
+/// Pass 2 on its own (synchronize()): the second half kick and the
+/// finiteness check. Returns the count of non-finite particles.
 double kick_check(std::size_t first, std::size_t last, double half, const double* __restrict x,
                   const double* __restrict y, const double* __restrict z, double* __restrict vx,
                   double* __restrict vy, double* __restrict vz, double* __restrict wx, double* __restrict wy,
                   double* __restrict wz, const double* __restrict fx, const double* __restrict fy,
                   const double* __restrict fz, const double* __restrict tx, const double* __restrict ty,
                   const double* __restrict tz, const double* __restrict im, const double* __restrict ii) {
-  constexpr double kMax = std::numeric_limits<double>::max();
   double bad = 0.0;
   for (std::size_t k = first; k < last; ++k) {
     const double hm = half * im[k], hi = half * ii[k];
     vx[k] += hm * fx[k]; vy[k] += hm * fy[k]; vz[k] += hm * fz[k];
     wx[k] += hi * tx[k]; wy[k] += hi * ty[k]; wz[k] += hi * tz[k];
-    bad += (std::fabs(x[k] + y[k] + z[k] + vx[k] + vy[k] + vz[k]) <= kMax) ? 0.0 : 1.0;
+    bad += nonfinite(x[k] + y[k] + z[k] + vx[k] + vy[k] + vz[k]);
   }
   return bad;
 }
@@ -327,15 +330,20 @@ void Subdomain::throw_nonfinite() const {
   throw RuntimeError(os.str());
 }
 
+bool Subdomain::take_pending_reduce(std::size_t n) {
+  const bool reduce = reduce_pending_;
+  reduce_pending_ = false;
+  if (reduce) reduce_split(n);
+  return reduce;
+}
+
 void Subdomain::synchronize() {
   if (!kick_pending_) return;
   kick_pending_ = false;
   const std::size_t n = store_.size();
   ParticleStore& s = store_;
-  const bool reduce = reduce_pending_;
-  reduce_pending_ = false;
-  if (reduce) reduce_split(n);
-  std::vector<double>& bad = partial_;
+  const bool reduce = take_pending_reduce(n);
+  std::vector<double>& bad = bad_partial_;
   bad.assign(static_cast<std::size_t>(threads()), 0.0);
   pool_->run([&](int t) {
     const auto [first, last] = finish_forces(t, reduce, n);
@@ -366,10 +374,8 @@ void Subdomain::step_deferred() {
   // wall contacts are finished first, per particle range.
   const bool stale = nlist_.layout_stale(s);
   const bool finish = kick_pending_;
-  const bool reduce = finish && reduce_pending_;
   kick_pending_ = false;
-  reduce_pending_ = false;
-  if (reduce) reduce_split(n);
+  const bool reduce = take_pending_reduce(n);  // pending only with a pending kick
   pool_->run([&](int t) {
     const auto [first, last] = finish_forces(t, reduce, n);
     auto pass = stale ? (finish ? &kick_drift_reset<false, true> : &kick_drift_reset<false, false>)
@@ -416,7 +422,7 @@ void Subdomain::compute_forces() {
 }
 
 std::vector<const std::vector<ContactRecord>*> Subdomain::contact_records() const {
-  const_cast<Subdomain*>(this)->synchronize();  // the wall contacts' records, see store()
+  synchronize_logically_const();  // the deferred wall contacts add records
   std::vector<const std::vector<ContactRecord>*> out;
   for (const auto& ts : scratch_) out.push_back(&ts.records);
   return out;
@@ -470,7 +476,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
           for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) v->assign(n, 0.0);
           ts.contacts.assign(n, 0);
         }
-        for (const auto& [lo, hi] : {std::pair{ts.lo, ts.own_lo}, std::pair{ts.own_hi, ts.hi}}) {
+        for (const auto& [lo, hi] : ts.shared_ranges()) {
           const auto a = static_cast<std::ptrdiff_t>(lo), b = static_cast<std::ptrdiff_t>(hi);
           for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) std::fill(v->begin() + a, v->begin() + b, 0.0);
           std::fill(ts.contacts.begin() + a, ts.contacts.begin() + b, 0u);
@@ -550,10 +556,9 @@ void Subdomain::reduce_split(std::size_t n) {
   cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
   auto weight = [&](std::size_t k) {
     double w = 1.0;
-    for (int t = 1; t < nt; ++t) {
-      const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
-      if ((k >= ts.lo && k < ts.own_lo) || (k >= ts.own_hi && k < ts.hi)) w += kReduceCost;
-    }
+    for (int t = 1; t < nt; ++t)
+      for (const auto& [lo, hi] : scratch_[static_cast<std::size_t>(t)].shared_ranges())
+        if (k >= lo && k < hi) w += kReduceCost;
     return w;
   };
   double total = 0.0;
@@ -579,7 +584,7 @@ void Subdomain::reduce_partials(std::size_t first, std::size_t last) {
   ParticleStore& s = store_;
   for (int t = 1; t < threads(); ++t) {
     const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
-    for (const auto& [lo, hi] : {std::pair{ts.lo, ts.own_lo}, std::pair{ts.own_hi, ts.hi}}) {
+    for (const auto& [lo, hi] : ts.shared_ranges()) {
       const std::size_t a = std::max(first, lo), b = std::min(last, hi);
       for (std::size_t k = a; k < b; ++k) {
         s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
@@ -951,9 +956,8 @@ MemoryUse Subdomain::memory_use() const {
   m.neighbor_lists = nlist_.bytes_without_history();
   m.contact_history = nlist_.history_bytes();
   for (const WallNeighbors& w : wall_lists_) {
-    m.neighbor_lists += (w.particle.capacity() + w.triangle.capacity()) * sizeof(uint32_t) +
-                        w.particle_id.capacity() * sizeof(std::uint64_t) + w.touching.capacity();
-    m.contact_history += w.history.capacity() * sizeof(double);
+    m.neighbor_lists += w.bytes_without_history();
+    m.contact_history += w.history_bytes();
   }
   for (const ThreadScratch& ts : scratch_)
     m.threads += (ts.fx.capacity() + ts.fy.capacity() + ts.fz.capacity() + ts.tx.capacity() + ts.ty.capacity() +
@@ -962,7 +966,7 @@ MemoryUse Subdomain::memory_use() const {
 }
 
 SubdomainStats Subdomain::stats() const {
-  const_cast<Subdomain*>(this)->synchronize();  // see store()
+  synchronize_logically_const();
   SubdomainStats st;
   const ParticleStore& s = store_;
   st.particles = s.size();

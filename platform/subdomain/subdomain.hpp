@@ -17,6 +17,7 @@
 #include "geometry/wall.hpp"
 #include "geometry/wall_neighbors.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -78,7 +79,7 @@ class Subdomain {
     return store_;
   }
   const ParticleStore& store() const {
-    const_cast<Subdomain*>(this)->synchronize();
+    synchronize_logically_const();
     return store_;
   }
   /// Particle count (needs no synchronisation).
@@ -140,6 +141,10 @@ class Subdomain {
   MemoryUse memory_use() const;
 
  private:
+  /// synchronize() for the const observers (store(), stats(),
+  /// contact_records()): the pending kick is an internal deferral, not
+  /// observable state.
+  void synchronize_logically_const() const { const_cast<Subdomain*>(this)->synchronize(); }
   /// One thread's batch workspace, batch bookkeeping and force accumulators.
   struct ThreadScratch {
     std::unique_ptr<ContactPipeline::Workspace> ws;
@@ -157,6 +162,8 @@ class Subdomain {
     /// own_lo == own_hi == hi when there is none). Only [lo, own_lo) and
     /// [own_hi, hi) of the private arrays are cleared and summed.
     std::size_t own_lo = 0, own_hi = 0;
+    /// The parts of the span that go through the private arrays.
+    std::array<std::pair<std::size_t, std::size_t>, 2> shared_ranges() const { return {{{lo, own_lo}, {own_hi, hi}}}; }
     std::size_t span[2][2] = {{0, 0}, {0, 0}};  ///< the span per list tier (near, far)
     double max_ratio = 0;
     MeshScratch mesh;                ///< mesh walls: per-particle feature bookkeeping
@@ -190,6 +197,8 @@ class Subdomain {
   /// for thread t: with `reduce`, the other threads' sums and the wall
   /// contacts of its particle range (pass2_split_). Returns that range.
   std::pair<std::size_t, std::size_t> finish_forces(int t, bool reduce, std::size_t n);
+  /// Take the pending force sum, if any, and split the particles for it.
+  bool take_pending_reduce(std::size_t n);
   void finish_wall_stats();
   [[noreturn]] void throw_nonfinite() const;
   void wall_forces();
