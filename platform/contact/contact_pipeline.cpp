@@ -59,9 +59,11 @@ void ContactPipeline::evaluate(Workspace& ws, const domel_pair_v1& pair, double 
   run(Slot::damping);
   for (uint32_t c = 0; c < n; ++c) buf.fn[c] = buf.fn_elastic[c] + buf.fn_damping[c];
   run(Slot::tangential);
-  std::fill_n(buf.tqx.begin(), n, 0.0);
-  std::fill_n(buf.tqy.begin(), n, 0.0);
-  std::fill_n(buf.tqz.begin(), n, 0.0);
+  if (has_torque()) {  // else they stay zero from the workspace's construction: only these slots write them
+    std::fill_n(buf.tqx.begin(), n, 0.0);
+    std::fill_n(buf.tqy.begin(), n, 0.0);
+    std::fill_n(buf.tqz.begin(), n, 0.0);
+  }
   if (slots_[static_cast<int>(Slot::rolling)]) {
     std::fill_n(buf.rolling_stiffness.begin(), n, 0.0);
     std::fill_n(buf.rolling_damping.begin(), n, 0.0);

@@ -33,6 +33,9 @@ class ContactPipeline {
 
   uint32_t history_stride() const { return history_stride_; }
   const ModelInstance* slot(Slot s) const { return slots_[static_cast<int>(s)].get(); }
+  /// A rolling or twisting model fills the torque couples (tqx, tqy, tqz);
+  /// without one they stay zero.
+  bool has_torque() const { return slots_[static_cast<int>(Slot::rolling)] || slots_[static_cast<int>(Slot::twisting)]; }
 
   /// Buffers of one batch (structure of arrays, capacity kBatchSize).
   struct Buffers {

@@ -241,7 +241,7 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
                         double* __restrict wy, double* __restrict wz, double* __restrict fx, double* __restrict fy,
                         double* __restrict fz, double* __restrict tx, double* __restrict ty, double* __restrict tz,
                         const double* __restrict im, const double* __restrict ii, const double* __restrict m,
-                        uint32_t* __restrict contacts, const double* __restrict x0, const double* __restrict y0,
+                        const double* __restrict x0, const double* __restrict y0,
                         const double* __restrict z0, double limit2, double limit2_far, double& far_tier,
                         double& bad) {
   const double g0 = g[0], g1 = g[1], g2 = g[2];
@@ -271,7 +271,6 @@ double kick_drift_reset(std::size_t first, std::size_t last, double dt, double h
     }
     fx[k] = m[k] * g0; fy[k] = m[k] * g1; fz[k] = m[k] * g2;
     tx[k] = 0.0; ty[k] = 0.0; tz[k] = 0.0;
-    contacts[k] = 0;
   }
   far_tier = tier;
   bad = bad_count;
@@ -384,7 +383,7 @@ void Subdomain::step_deferred() {
     partial[q] = pass(first, last, dt, half, pending_half_, gravity_, s.x.data(), s.y.data(), s.z.data(),
                       s.vx.data(), s.vy.data(), s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(),
                       s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data(), s.inv_mass.data(),
-                      s.inv_inertia.data(), s.mass.data(), s.contacts.data(), nlist_.x0(), nlist_.y0(), nlist_.z0(),
+                      s.inv_inertia.data(), s.mass.data(), nlist_.x0(), nlist_.y0(), nlist_.z0(),
                       nlist_.rebuild_displacement2(), nlist_.far_tier_displacement2(), tier[q], bad[q]);
   });
   if (reduce) finish_wall_stats();
@@ -415,7 +414,6 @@ void Subdomain::compute_forces() {
       s.fy[k] = s.mass[k] * gravity_[1];
       s.fz[k] = s.mass[k] * gravity_[2];
       s.tx[k] = s.ty[k] = s.tz[k] = 0.0;
-      s.contacts[k] = 0;
     }
   });
   contact_forces();
@@ -430,6 +428,7 @@ std::vector<const std::vector<ContactRecord>*> Subdomain::contact_records() cons
 
 void Subdomain::contact_forces(bool defer_reduce) {
   forces_time_ = time_;
+  contacts_counted_ = false;
   last_max_overlap_ratio_ = 0;
   for (auto& ts : scratch_) ts.records.clear();
   pair_forces(defer_reduce);
@@ -444,8 +443,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
   ParticleStore& s = store_;
   const int nt = threads();
   const bool far = far_active_;
-  const Accumulator direct{s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data(),
-                           s.contacts.data()};
+  const Accumulator direct{s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data()};
   for (auto& ts : scratch_) {
     ts.n_contacts = 0;
     ts.max_ratio = 0.0;
@@ -454,8 +452,9 @@ void Subdomain::pair_forces(bool defer_reduce) {
     ThreadScratch& ts = scratch_[0];
     ts.own_lo = 0;
     ts.own_hi = s.size();
-    pair_range(0, nlist_.near_size(), ts, direct, direct);
-    if (far) pair_range(nlist_.near_size(), nlist_.size(), ts, direct, direct);
+    const auto range = pair_kernel(false);
+    (this->*range)(0, nlist_.near_size(), ts, direct, direct);
+    if (far) (this->*range)(nlist_.near_size(), nlist_.size(), ts, direct, direct);
   } else {
     // Each thread owns a fixed, contiguous range of each tier of the pair
     // list (so each list entry and its history has one writer). Thread 0 adds
@@ -472,20 +471,17 @@ void Subdomain::pair_forces(bool defer_reduce) {
       ThreadScratch& ts = scratch_[q];
       Accumulator shared = direct;
       if (t > 0) {
-        if (ts.contacts.size() != n) {
+        if (ts.fx.size() != n)
           for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) v->assign(n, 0.0);
-          ts.contacts.assign(n, 0);
-        }
         for (const auto& [lo, hi] : ts.shared_ranges()) {
           const auto a = static_cast<std::ptrdiff_t>(lo), b = static_cast<std::ptrdiff_t>(hi);
           for (auto* v : {&ts.fx, &ts.fy, &ts.fz, &ts.tx, &ts.ty, &ts.tz}) std::fill(v->begin() + a, v->begin() + b, 0.0);
-          std::fill(ts.contacts.begin() + a, ts.contacts.begin() + b, 0u);
         }
-        shared = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data(),
-                  ts.contacts.data()};
+        shared = {ts.fx.data(), ts.fy.data(), ts.fz.data(), ts.tx.data(), ts.ty.data(), ts.tz.data()};
       }
-      pair_range(split_[0][q], split_[0][q + 1], ts, direct, shared);
-      if (far) pair_range(split_[1][q], split_[1][q + 1], ts, direct, shared);
+      const auto range = pair_kernel(t > 0);  // thread 0 adds all its forces into the store
+      (this->*range)(split_[0][q], split_[0][q + 1], ts, direct, shared);
+      if (far) (this->*range)(split_[1][q], split_[1][q + 1], ts, direct, shared);
     });
     if (defer_reduce) {
       reduce_pending_ = true;  // folded into the next pass 1 or synchronize()
@@ -589,7 +585,6 @@ void Subdomain::reduce_partials(std::size_t first, std::size_t last) {
       for (std::size_t k = a; k < b; ++k) {
         s.fx[k] += ts.fx[k]; s.fy[k] += ts.fy[k]; s.fz[k] += ts.fz[k];
         s.tx[k] += ts.tx[k]; s.ty[k] += ts.ty[k]; s.tz[k] += ts.tz[k];
-        s.contacts[k] += ts.contacts[k];
       }
     }
   }
@@ -663,6 +658,12 @@ void Subdomain::balance_pairs(int nt) {
   split_builds_ = nlist_.builds();
 }
 
+Subdomain::PairRange Subdomain::pair_kernel(bool zoned) const {
+  if (pipeline_->has_torque()) return zoned ? &Subdomain::pair_range<true, true> : &Subdomain::pair_range<false, true>;
+  return zoned ? &Subdomain::pair_range<true, false> : &Subdomain::pair_range<false, false>;
+}
+
+template <bool kZoned, bool kTorque>
 void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& own,
                            const Accumulator& shared) {
   const ParticleStore& s = store_;
@@ -700,6 +701,7 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   // unsigned k - zone_lo < zone_width: k in [own_lo, own_hi)
   const auto zone_lo = static_cast<uint32_t>(ts.own_lo);
   const auto zone_width = static_cast<uint32_t>(ts.own_hi - ts.own_lo);
+  const Accumulator own_acc = own, shared_acc = shared;
 
   std::size_t e = first;
   while (e < last) {
@@ -774,18 +776,23 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       const double fn = fn_[q];
       const double ftx = ftx_[q], fty = fty_[q], ftz = ftz_[q];
       const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
-      const Accumulator& ai = i - zone_lo < zone_width ? own : shared;
-      const Accumulator& aj = j - zone_lo < zone_width ? own : shared;
+      // Without zones (one thread) both are `direct`, a local copy whose
+      // pointers stay in registers instead of being reloaded per contact.
+      const Accumulator& ai = (!kZoned || i - zone_lo < zone_width) ? own_acc : shared_acc;
+      const Accumulator& aj = (!kZoned || j - zone_lo < zone_width) ? own_acc : shared_acc;
       ai.fx[i] += fx; ai.fy[i] += fy; ai.fz[i] += fz;
       aj.fx[j] -= fx; aj.fy[j] -= fy; aj.fz[j] -= fz;
       // n x F_t
       const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
       const double ci = lever_i[q], cj = lever_j[q];
-      const double mx = tqx_[q], my = tqy_[q], mz = tqz_[q];
-      ai.tx[i] += -ci * cx + mx; ai.ty[i] += -ci * cy + my; ai.tz[i] += -ci * cz + mz;
-      aj.tx[j] += -cj * cx - mx; aj.ty[j] += -cj * cy - my; aj.tz[j] += -cj * cz - mz;
-      ++ai.contacts[i];
-      ++aj.contacts[j];
+      if constexpr (kTorque) {
+        const double mx = tqx_[q], my = tqy_[q], mz = tqz_[q];
+        ai.tx[i] += -ci * cx + mx; ai.ty[i] += -ci * cy + my; ai.tz[i] += -ci * cz + mz;
+        aj.tx[j] += -cj * cx - mx; aj.ty[j] += -cj * cy - my; aj.tz[j] += -cj * cz - mz;
+      } else {  // no rolling or twisting model: the couple is zero (adding it changes no bit: sums start at +0)
+        ai.tx[i] += -ci * cx; ai.ty[i] += -ci * cy; ai.tz[i] += -ci * cz;
+        aj.tx[j] += -cj * cx; aj.ty[j] += -cj * cy; aj.tz[j] += -cj * cz;
+      }
       copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
                stride);
     }
@@ -800,6 +807,28 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   }
   ts.n_contacts += contacts;
   ts.max_ratio = std::max(ts.max_ratio, max_ratio);
+}
+
+void Subdomain::count_contacts() {
+  // From the contact flags the last force evaluation left in the lists (the
+  // screened part of the pair list; the walls active then), in the layout it
+  // ran on: store() calls this before anyone can change the layout.
+  ParticleStore& s = store_;
+  s.contacts.assign(s.size(), 0u);
+  const std::size_t screened = far_active_ ? nlist_.size() : nlist_.near_size();
+  if (!nlist_.layout_stale(s))
+    for (std::size_t e = 0; e < screened; ++e)
+      if (nlist_.touching[e]) {
+        ++s.contacts[nlist_.i[e]];
+        ++s.contacts[nlist_.j[e]];
+      }
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
+    if (!walls_now_[w].active(forces_time_)) continue;
+    const WallNeighbors& list = wall_lists_[w];
+    for (std::size_t e = 0; e < list.particle.size(); ++e)
+      if (list.touching[e] && list.particle[e] < s.size()) ++s.contacts[list.particle[e]];
+  }
+  contacts_counted_ = true;
 }
 
 void Subdomain::prune_removed_walls() {
@@ -851,7 +880,6 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
         const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
         const double ci = ts.ci[q];
         s.tx[i] += -ci * cx + buf.tqx[q]; s.ty[i] += -ci * cy + buf.tqy[q]; s.tz[i] += -ci * cz + buf.tqz[q];
-        ++s.contacts[i];
         copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
         if (record_)  // the contact point lies on the wall, ci from the centre along -n
           ts.records.push_back({i, ContactRecord::kWall, fn * nx + ftx, fn * ny + fty, fn * nz + ftz,
@@ -961,7 +989,7 @@ MemoryUse Subdomain::memory_use() const {
   }
   for (const ThreadScratch& ts : scratch_)
     m.threads += (ts.fx.capacity() + ts.fy.capacity() + ts.fz.capacity() + ts.tx.capacity() + ts.ty.capacity() +
-                  ts.tz.capacity()) * sizeof(double) + ts.contacts.capacity() * sizeof(uint32_t);
+                  ts.tz.capacity()) * sizeof(double);
   return m;
 }
 

@@ -74,12 +74,16 @@ class Subdomain {
   /// step_deferred() is finished first (synchronize()). The const overload
   /// does so too (the pending kick is an internal deferral, not observable
   /// state); not for concurrent use from several threads.
+  /// Its per-particle `contacts` are counted here, from the lists' contact
+  /// flags, once per force evaluation (no work in the step loop).
   ParticleStore& store() {
     synchronize();
+    if (!contacts_counted_) count_contacts();
     return store_;
   }
   const ParticleStore& store() const {
     synchronize_logically_const();
+    if (!contacts_counted_) const_cast<Subdomain*>(this)->count_contacts();
     return store_;
   }
   /// Particle count (needs no synchronisation).
@@ -151,7 +155,6 @@ class Subdomain {
     std::vector<uint32_t> entry;     ///< list entry of each batch slot
     std::vector<double> ci, cj;      ///< lever arms of each batch slot
     std::vector<double> fx, fy, fz, tx, ty, tz;  ///< accumulators (threads > 0)
-    std::vector<uint32_t> contacts;
     std::vector<ContactRecord> records;  ///< contact forces on recording steps
     std::size_t n_contacts = 0;
     std::size_t wall_contacts = 0;
@@ -173,7 +176,6 @@ class Subdomain {
   /// Where a thread adds forces: the store itself (thread 0) or its own arrays.
   struct Accumulator {
     double *fx, *fy, *fz, *tx, *ty, *tz;
-    uint32_t* contacts;
   };
 
   void rebuild_lists();
@@ -188,9 +190,16 @@ class Subdomain {
   void reduce_partials(std::size_t first, std::size_t last);
   void reduce_split(std::size_t n);
   void balance_pairs(int nt);
-  /// Forces on particles in [ts.own_lo, ts.own_hi) go to `own`, on the others to `shared`.
+  /// Forces on particles in [ts.own_lo, ts.own_hi) go to `own`, on the others
+  /// to `shared`; without kZoned all go to `own`. kTorque: the pipeline has
+  /// a rolling or twisting model, whose couples are added.
+  template <bool kZoned, bool kTorque>
   void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& own,
                   const Accumulator& shared);
+  using PairRange = void (Subdomain::*)(std::size_t, std::size_t, ThreadScratch&, const Accumulator&,
+                                        const Accumulator&);
+  /// The pair_range instance for this pipeline, with or without zones.
+  PairRange pair_kernel(bool zoned) const;
   /// Set lo/hi and own_lo/own_hi of every thread for this step (threads > 1).
   void thread_zones(bool far);
   /// The part of the last force evaluation left to the integration pass,
@@ -203,6 +212,8 @@ class Subdomain {
   [[noreturn]] void throw_nonfinite() const;
   void wall_forces();
   void prune_removed_walls();
+  /// Fill store_.contacts from the last force evaluation (store()).
+  void count_contacts();
   void wall_range(ThreadScratch& ts, std::size_t first, std::size_t last);
 
   std::string name_;
@@ -231,6 +242,7 @@ class Subdomain {
   std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
   bool reduce_pending_ = false;
+  bool contacts_counted_ = true;  ///< store_.contacts is up to date (count_contacts)
   bool kick_pending_ = false;  ///< the last step's second half kick is still to do (store())
   double pending_half_ = 0;    ///< its half time step
   double forces_time_ = 0;     ///< time_ at the last force evaluation (wall activity)

@@ -97,3 +97,43 @@ TEST(Threads, DeferredStepsEqualCompleteSteps) {
     EXPECT_EQ(sa.max_overlap_ratio, sb.max_overlap_ratio);
   }
 }
+
+TEST(Threads, PerParticleContactsCountTheTouchingPairsAndWalls) {
+  // store().contacts (the VTK coordination number) is counted from the
+  // lists' contact flags when the store is read, not in the step loop. It
+  // must equal a brute-force count over all pairs (centre distance below
+  // r_i + r_j, the screen's own test) and the box's five planes (gap below
+  // r), after deferred steps (whose wall contacts are finished by store()).
+  const double a = 1.02 * 0.0028;
+  for (int threads : {1, 2}) {
+    auto sim = settle(threads, 700, true);
+    const auto& sd = *sim->subdomains[0];
+    const auto& s = sd.store();
+    std::vector<std::uint32_t> want(s.size(), 0);
+    std::size_t pairs = 0, walls = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      for (std::size_t j = i + 1; j < s.size(); ++j) {
+        const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
+        const double rsum = s.radius[i] + s.radius[j];
+        if (dx * dx + dy * dy + dz * dz < rsum * rsum) {
+          ++want[i];
+          ++want[j];
+          ++pairs;
+        }
+      }
+      for (double gap : {s.x[i], 10 * a - s.x[i], s.y[i], 10 * a - s.y[i], s.z[i]})
+        if (gap < s.radius[i]) {
+          ++want[i];
+          ++walls;
+        }
+    }
+    const auto st = sd.stats();
+    EXPECT_EQ(st.contacts, pairs) << threads << " threads";
+    EXPECT_EQ(st.wall_contacts, walls) << threads << " threads";
+    std::printf("%d threads: %zu pair and %zu wall contacts\n", threads, pairs, walls);
+    EXPECT_GT(pairs, 100u);  // the bottom of the column is in contact
+    EXPECT_GT(walls, 0u);
+    ASSERT_EQ(s.contacts.size(), s.size());
+    for (std::size_t k = 0; k < s.size(); ++k) ASSERT_EQ(s.contacts[k], want[k]) << threads << " threads, particle " << k;
+  }
+}
