@@ -490,7 +490,9 @@ void Subdomain::pair_forces(bool defer_reduce) {
     }
   }
   last_contacts_ = 0;
+  thread_contacts_.clear();
   for (const auto& ts : scratch_) {
+    thread_contacts_.push_back(ts.n_contacts);
     last_contacts_ += ts.n_contacts;
     last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.max_ratio);
   }
@@ -535,12 +537,44 @@ void Subdomain::thread_zones(bool far) {
   }
 }
 
+void Subdomain::refresh_wall_work() {
+  // The wall contacts of a particle are evaluated by the thread whose
+  // pass-2 range holds it. They sit where the walls are, at one end of the
+  // spatially ordered store (a floor: the first particles), so they weigh in
+  // the split. Per wall-list entry: its gap test, and for a contact the
+  // batch gather, the contact kernels and the scatter. Kept as (particle,
+  // cost) in particle order with running sums, refreshed with the pair
+  // split (balance_pairs): after each list build and every kBalanceEvery
+  // steps. Only the split depends on it, never a result.
+  constexpr double kWallEntryCost = 1.0;
+  constexpr double kWallContactCost = 6.0;
+  wall_work_particle_.clear();
+  wall_work_sum_.assign(1, 0.0);
+  std::vector<std::pair<uint32_t, double>>& ev = wall_work_scratch_;
+  ev.clear();
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
+    if (!walls_now_[w].active(time_)) continue;
+    const WallNeighbors& list = wall_lists_[w];
+    const auto mid = static_cast<std::ptrdiff_t>(ev.size());
+    for (std::size_t e = 0; e < list.particle.size(); ++e)  // ascending particle order
+      ev.emplace_back(list.particle[e], kWallEntryCost + (list.touching[e] ? kWallContactCost : 0.0));
+    std::inplace_merge(ev.begin(), ev.begin() + mid, ev.end(),
+                       [](const auto& x, const auto& y) { return x.first < y.first; });
+  }
+  for (const auto& [k, cost] : ev) {
+    wall_work_particle_.push_back(k);
+    wall_work_sum_.push_back(wall_work_sum_.back() + cost);
+  }
+}
+
 void Subdomain::reduce_split(std::size_t n) {
   // Split [0, n) for the second half kick so that each thread has the same
   // estimated cost: a particle costs 1, plus kReduceCost for each other
-  // thread whose force span covers it (the reduction's loads and adds).
-  // Equal particle counts would leave the whole reduction to the threads
-  // whose share overlaps the spans. Deterministic: from the spans only.
+  // thread whose force span covers it (the reduction's loads and adds), plus
+  // its wall contacts (refresh_wall_work). Equal particle counts would leave
+  // the whole reduction to the threads whose share overlaps the spans, and
+  // the floor's contacts to the first thread. Deterministic: from the spans
+  // and the lists only.
   constexpr double kReduceCost = 1.5;
   const int nt = threads();
   std::vector<std::size_t> cuts = {0, n};
@@ -557,22 +591,29 @@ void Subdomain::reduce_split(std::size_t n) {
         if (k >= lo && k < hi) w += kReduceCost;
     return w;
   };
-  double total = 0.0;
-  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) total += static_cast<double>(cuts[c + 1] - cuts[c]) * weight(cuts[c]);
+  std::vector<double> seg_w(cuts.size() - 1);
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) seg_w[c] = weight(cuts[c]);
+  // The cost of the particles [0, k): non-decreasing in k.
+  auto cost_below = [&](std::size_t k) {
+    double sum = 0.0;
+    for (std::size_t c = 0; c + 1 < cuts.size() && cuts[c] < k; ++c)
+      sum += static_cast<double>(std::min(k, cuts[c + 1]) - cuts[c]) * seg_w[c];
+    const auto walls = std::lower_bound(wall_work_particle_.begin(), wall_work_particle_.end(), k);
+    return sum + wall_work_sum_[static_cast<std::size_t>(walls - wall_work_particle_.begin())];
+  };
+  const double total = cost_below(n);
   pass2_split_.assign(static_cast<std::size_t>(nt) + 1, n);
   pass2_split_[0] = 0;
-  double acc = 0.0;
-  int q = 1;
-  for (std::size_t c = 0; c + 1 < cuts.size() && q < nt; ++c) {
-    const double w = weight(cuts[c]);
-    const double seg = static_cast<double>(cuts[c + 1] - cuts[c]) * w;
-    while (q < nt && acc + seg >= total * q / nt) {
-      const double need = total * q / nt - acc;
-      pass2_split_[static_cast<std::size_t>(q)] =
-          std::min(cuts[c + 1], cuts[c] + static_cast<std::size_t>(std::ceil(need / w)));
-      ++q;
+  for (int q = 1; q < nt; ++q) {
+    // the first k with cost_below(k) >= total q / nt
+    const double goal = total * q / nt;
+    std::size_t lo = pass2_split_[static_cast<std::size_t>(q) - 1], hi = n;
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (cost_below(mid) >= goal) hi = mid;
+      else lo = mid + 1;
     }
-    acc += seg;
+    pass2_split_[static_cast<std::size_t>(q)] = lo;
   }
 }
 
@@ -619,14 +660,29 @@ void Subdomain::balance_pairs(int nt) {
   // were no better. Even entry counts leave the thread with the
   // dense, settled bottom of a column with most of the work. The split
   // depends only on the list and its contact flags, never on timings, so a
-  // run is bit-identical for a given thread count. Recomputed every
-  // kBalanceEvery steps and after each list build.
+  // run is bit-identical for a given thread count. Recomputed after each
+  // list build, and every kBalanceEvery steps when the threads' estimated
+  // costs in the last force evaluation (their ranges' entries, and their
+  // contacts as counted there) differ by more than kRebalanceAt: the two
+  // serial scans of the list are then skipped while the contacts stay put
+  // (at 10k they cost ~2 % of a two-thread step when done every 32 steps).
   constexpr uint64_t kContactCost = 12;
   constexpr std::uint64_t kBalanceEvery = 32;
+  constexpr double kRebalanceAt = 0.01;
   const std::size_t tiers[3] = {0, nlist_.near_size(), nlist_.size()};
-  if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds() &&
-      steps_ % kBalanceEvery != 0)
-    return;
+  if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds()) {
+    if (steps_ % kBalanceEvery != 0 || thread_contacts_.size() != static_cast<std::size_t>(nt)) return;
+    double lo = 0, hi = 0;
+    for (std::size_t q = 0; q < static_cast<std::size_t>(nt); ++q) {
+      std::size_t entries = split_[0][q + 1] - split_[0][q];
+      if (far_active_) entries += split_[1][q + 1] - split_[1][q];
+      const double cost = static_cast<double>(entries + kContactCost * thread_contacts_[q]);
+      lo = q == 0 ? cost : std::min(lo, cost);
+      hi = q == 0 ? cost : std::max(hi, cost);
+    }
+    if (hi - lo <= kRebalanceAt * hi) return;
+  }
+  refresh_wall_work();
   const uint8_t* touching = nlist_.touching.data();
   const uint32_t* li = nlist_.i.data();
   const uint32_t* lj = nlist_.j.data();
@@ -702,6 +758,12 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   const auto zone_lo = static_cast<uint32_t>(ts.own_lo);
   const auto zone_width = static_cast<uint32_t>(ts.own_hi - ts.own_lo);
   const Accumulator own_acc = own, shared_acc = shared;
+  // a - b and a + (-b) are the same IEEE operation, so both sides use one add
+  const auto add = [](const Accumulator& a, uint32_t k, double fx, double fy, double fz, double tx, double ty,
+                      double tz) {
+    a.fx[k] += fx; a.fy[k] += fy; a.fz[k] += fz;
+    a.tx[k] += tx; a.ty[k] += ty; a.tz[k] += tz;
+  };
 
   std::size_t e = first;
   while (e < last) {
@@ -776,23 +838,22 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       const double fn = fn_[q];
       const double ftx = ftx_[q], fty = fty_[q], ftz = ftz_[q];
       const double fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
-      // Without zones (one thread) both are `direct`, a local copy whose
-      // pointers stay in registers instead of being reloaded per contact.
-      const Accumulator& ai = (!kZoned || i - zone_lo < zone_width) ? own_acc : shared_acc;
-      const Accumulator& aj = (!kZoned || j - zone_lo < zone_width) ? own_acc : shared_acc;
-      ai.fx[i] += fx; ai.fy[i] += fy; ai.fz[i] += fz;
-      aj.fx[j] -= fx; aj.fy[j] -= fy; aj.fz[j] -= fz;
       // n x F_t
       const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;
       const double ci = lever_i[q], cj = lever_j[q];
-      if constexpr (kTorque) {
-        const double mx = tqx_[q], my = tqy_[q], mz = tqz_[q];
-        ai.tx[i] += -ci * cx + mx; ai.ty[i] += -ci * cy + my; ai.tz[i] += -ci * cz + mz;
-        aj.tx[j] += -cj * cx - mx; aj.ty[j] += -cj * cy - my; aj.tz[j] += -cj * cz - mz;
-      } else {  // no rolling or twisting model: the couple is zero (adding it changes no bit: sums start at +0)
-        ai.tx[i] += -ci * cx; ai.ty[i] += -ci * cy; ai.tz[i] += -ci * cz;
-        aj.tx[j] += -cj * cx; aj.ty[j] += -cj * cy; aj.tz[j] += -cj * cz;
+      double tix = -ci * cx, tiy = -ci * cy, tiz = -ci * cz;
+      double tjx = -cj * cx, tjy = -cj * cy, tjz = -cj * cz;
+      if constexpr (kTorque) {  // else the couple is zero, and adding it would change no bit (sums start at +0)
+        tix += tqx_[q]; tiy += tqy_[q]; tiz += tqz_[q];
+        tjx -= tqx_[q]; tjy -= tqy_[q]; tjz -= tqz_[q];
       }
+      // A branch, not a select of the accumulator: it is taken the same way
+      // for all but the few particles of the band other threads share, and
+      // the own path keeps its pointers in registers (one writer: always).
+      if (!kZoned || i - zone_lo < zone_width) add(own_acc, i, fx, fy, fz, tix, tiy, tiz);
+      else add(shared_acc, i, fx, fy, fz, tix, tiy, tiz);
+      if (!kZoned || j - zone_lo < zone_width) add(own_acc, j, -fx, -fy, -fz, tjx, tjy, tjz);
+      else add(shared_acc, j, -fx, -fy, -fz, tjx, tjy, tjz);
       copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
                stride);
     }

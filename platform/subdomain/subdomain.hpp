@@ -189,6 +189,8 @@ class Subdomain {
   void pair_forces(bool defer_reduce);
   void reduce_partials(std::size_t first, std::size_t last);
   void reduce_split(std::size_t n);
+  /// Wall-contact work per particle for reduce_split (with balance_pairs).
+  void refresh_wall_work();
   void balance_pairs(int nt);
   /// Forces on particles in [ts.own_lo, ts.own_hi) go to `own`, on the others
   /// to `shared`; without kZoned all go to `own`. kTorque: the pipeline has
@@ -241,12 +243,16 @@ class Subdomain {
   std::vector<double> partial_, tier_partial_;  ///< per-thread counts of the integration passes
   std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
+  std::vector<std::size_t> thread_contacts_;  ///< per thread: pair contacts of the last force evaluation
   bool reduce_pending_ = false;
   bool contacts_counted_ = true;  ///< store_.contacts is up to date (count_contacts)
   bool kick_pending_ = false;  ///< the last step's second half kick is still to do (store())
   double pending_half_ = 0;    ///< its half time step
   double forces_time_ = 0;     ///< time_ at the last force evaluation (wall activity)
   std::vector<double> bad_partial_;  ///< per-thread counts of non-finite particles
+  std::vector<uint32_t> wall_work_particle_;  ///< refresh_wall_work: wall-list entries' particles, ascending
+  std::vector<double> wall_work_sum_ = {0.0};  ///< and the running sum of their costs (one longer)
+  std::vector<std::pair<uint32_t, double>> wall_work_scratch_;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   static constexpr std::size_t kReorderMinParticles = 5000;
   std::size_t reorder_every_ = 20;  ///< list builds between spatial re-orderings (0: never)
