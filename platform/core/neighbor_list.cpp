@@ -81,10 +81,18 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   // other than the first.
   std::size_t live = 0;
   for (std::size_t k = 0; k < i.size(); ++k) live += touching[k] ? 1 : 0;
-  LiveHistory old(live);
+  // When no particle was added, removed or re-ordered since the last build
+  // (most builds), a live pair keeps its indices and orientation: its new
+  // entry is found in its row of the new list (rows_of below), and only the
+  // live pairs are looked up. Otherwise by ids, through the table.
+  const bool same_layout = !layout_stale(s);
+  LiveHistory old(same_layout ? 0 : live);
+  std::vector<std::pair<uint32_t, uint32_t>> old_pairs;
+  if (same_layout) old_pairs.reserve(live);
   for (std::size_t k = 0, row = 0; k < i.size(); ++k) {
     if (!touching[k]) continue;
-    old.add(pair_key(built_ids_[i[k]], built_ids_[j[k]]));
+    if (same_layout) old_pairs.emplace_back(i[k], j[k]);
+    else old.add(pair_key(built_ids_[i[k]], built_ids_[j[k]]));
     std::copy_n(history.begin() + static_cast<std::ptrdiff_t>(k * stride_), stride_,
                 history.begin() + static_cast<std::ptrdiff_t>(row * stride_));  // row <= k: front to back is safe
     ++row;
@@ -165,15 +173,16 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
         c[a] = static_cast<int>(std::min(static_cast<double>(dim[a] - 1), std::max(0.0, (p[a] - lo[a]) * inv[a])));
     };
     const std::size_t ncell = static_cast<std::size_t>(dim[0]) * dim[1] * dim[2];
-    std::vector<uint32_t> start(ncell + 1, 0), order(n), cell_index(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      int c[3];
-      cell_of(k, c);
-      cell_index[k] = static_cast<uint32_t>((static_cast<std::size_t>(c[2]) * dim[1] + c[1]) * dim[0] + c[0]);
-      ++start[cell_index[k] + 1];
-    }
-    for (std::size_t c = 0; c < ncell; ++c) start[c + 1] += start[c];
+    std::vector<uint32_t> start(ncell + 1, 0), order(n);
     {
+      std::vector<uint32_t> cell_index(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        int c[3];
+        cell_of(k, c);
+        cell_index[k] = static_cast<uint32_t>((static_cast<std::size_t>(c[2]) * dim[1] + c[1]) * dim[0] + c[0]);
+        ++start[cell_index[k] + 1];
+      }
+      for (std::size_t c = 0; c < ncell; ++c) start[c + 1] += start[c];
       std::vector<uint32_t> fill(start.begin(), start.end() - 1);
       for (std::size_t k = 0; k < n; ++k) order[fill[cell_index[k]]++] = static_cast<uint32_t>(k);
     }
@@ -183,9 +192,12 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     // count (entries in order of a, then of the cell scan).
     // visit(a, b, near) for each pair within the cut-off, b > a.
     auto for_each_pair = [&](std::size_t a_first, std::size_t a_last, auto&& visit) {
+      const double skin = skin_;
       for (std::size_t a = a_first; a < a_last; ++a) {
         int c[3];
         cell_of(a, c);
+        const double xa = s.x[a], ya = s.y[a], za = s.z[a], ra = s.radius[a];
+        const bool fixed_a = (s.flags[a] & ParticleStore::kFixed) != 0;
         for (int dz = -1; dz <= 1; ++dz) {
           const int cz = c[2] + dz;
           if (cz < 0 || cz >= dim[2]) continue;
@@ -199,11 +211,12 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
               for (uint32_t q = start[cc]; q < start[cc + 1]; ++q) {
                 const uint32_t b = order[q];
                 if (b <= a) continue;
-                if ((s.flags[a] & s.flags[b] & ParticleStore::kFixed) != 0) continue;  // two fixed: never interact
-                const double ddx = s.x[a] - s.x[b], ddy = s.y[a] - s.y[b], ddz = s.z[a] - s.z[b];
-                const double cut = s.radius[a] + s.radius[b] + skin_;
+                if (fixed_a && (s.flags[b] & ParticleStore::kFixed) != 0) continue;  // two fixed: never interact
+                const double rb = s.radius[b];
+                const double ddx = xa - s.x[b], ddy = ya - s.y[b], ddz = za - s.z[b];
+                const double cut = ra + rb + skin;
                 const double d2 = ddx * ddx + ddy * ddy + ddz * ddz;
-                if (d2 < cut * cut) visit(a, b, std::sqrt(d2) - s.radius[a] - s.radius[b] < h);
+                if (d2 < cut * cut) visit(a, b, std::sqrt(d2) - ra - rb < h);
               }
             }
           }
@@ -276,14 +289,42 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     // each entry and each row is written by one thread)...
     constexpr std::uint32_t kNone = LiveHistory::kNone;
     std::vector<std::uint32_t> dest(live, kNone);
-    in_ranges(i.size(), [&](std::size_t first, std::size_t last, int) {
-      for (std::size_t k = first; k < last; ++k) {
-        const std::uint32_t row = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
-        if (row == kNone) continue;
-        dest[row] = static_cast<std::uint32_t>(k);
-        touching[k] = 1;
+    if (same_layout) {
+      // Each tier lists its entries in order of a = min(i, j), the particle
+      // whose cell scan found the pair: row offsets per tier, then a scan of
+      // the pair's row (~10 entries) per live pair.
+      std::vector<std::uint32_t> rows_of(2 * (n + 1), 0);
+      for (std::size_t k = 0; k < i.size(); ++k) ++rows_of[(k < near_size_ ? 0 : n + 1) + std::min(i[k], j[k]) + 1];
+      for (std::size_t t = 0; t < 2; ++t) {
+        std::uint32_t* r = rows_of.data() + t * (n + 1);
+        r[0] = static_cast<std::uint32_t>(t == 0 ? 0 : near_size_);
+        for (std::size_t a = 0; a < n; ++a) r[a + 1] += r[a];
       }
-    });
+      in_ranges(live, [&](std::size_t first, std::size_t last, int) {
+        for (std::size_t row = first; row < last; ++row) {
+          const auto [oi, oj] = old_pairs[row];
+          const std::size_t a = std::min(oi, oj);
+          for (std::size_t t = 0; t < 2 && dest[row] == kNone; ++t) {
+            const std::uint32_t* r = rows_of.data() + t * (n + 1);
+            for (std::size_t k = r[a]; k < r[a + 1]; ++k)
+              if (i[k] == oi && j[k] == oj) {
+                dest[row] = static_cast<std::uint32_t>(k);
+                touching[k] = 1;
+                break;
+              }
+          }
+        }
+      });
+    } else {
+      in_ranges(i.size(), [&](std::size_t first, std::size_t last, int) {
+        for (std::size_t k = first; k < last; ++k) {
+          const std::uint32_t row = old.find(pair_key(s.id[i[k]], s.id[j[k]]));
+          if (row == kNone) continue;
+          dest[row] = static_cast<std::uint32_t>(k);
+          touching[k] = 1;
+        }
+      });
+    }
     // ...then each row moved there in place, following chains: a row whose
     // place still holds an unmoved live row swaps it out and carries it on.
     // Rows of contacts that left the list (a deleted particle) are dropped.

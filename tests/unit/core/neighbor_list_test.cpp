@@ -216,6 +216,57 @@ TEST(NeighborList, HistoryOfRemovedParticlesIsDroppedAndTheRestCarried) {
   }
 }
 
+TEST(NeighborList, HistoryIsCarriedByRowWhenTheLayoutIsUnchanged) {
+  // Without an insertion, removal or re-ordering since the last build (most
+  // builds), the carry-over finds each live pair in its row of the new list
+  // instead of through the id table. Particles move (some pairs leave the
+  // cut-off, others enter, some change tier); each live pair still in the
+  // list must get its own row back, every other entry zero, serial or
+  // threaded.
+  for (int threads : {1, 2}) {
+    ParticleStore s = cloud(5000, 31);  // >= 4096: the threaded scan and carry run
+    NeighborList nl;
+    nl.configure(0.0008, 3);
+    ThreadPool pool(threads);
+    nl.build(s, &pool);
+    std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
+    for (std::size_t k = 0; k < nl.size(); k += 3) {
+      const double tag = static_cast<double>(s.id[nl.i[k]] * 100000 + s.id[nl.j[k]]);
+      nl.touching[k] = 1;
+      for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
+      expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
+    }
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> step(-0.0006, 0.0006);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      s.x[k] += step(rng);
+      s.y[k] += step(rng);
+      s.z[k] += step(rng);
+    }
+    ASSERT_FALSE(nl.layout_stale(s));
+    nl.build(s, &pool);
+    const auto now = brute(s, 0.0008);
+    ASSERT_EQ(nl.size(), now.size());
+    std::size_t carried = 0;
+    for (std::size_t k = 0; k < nl.size(); ++k) {
+      auto it = expected.find({s.id[nl.i[k]], s.id[nl.j[k]]});
+      if (it == expected.end()) {
+        ASSERT_EQ(nl.touching[k], 0) << threads << " threads, entry " << k;
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(nl.history[k * 3 + c], 0.0);
+        continue;
+      }
+      ++carried;
+      ASSERT_EQ(nl.touching[k], 1) << threads << " threads, entry " << k;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(nl.history[k * 3 + c], it->second + c) << threads << " threads, entry " << k;
+    }
+    std::size_t still = 0;
+    for (const auto& [key, tag] : expected) still += now.count(key);
+    EXPECT_EQ(carried, still) << threads << " threads";
+    EXPECT_LT(still, expected.size());  // some live pairs left the list
+    EXPECT_GT(still, expected.size() / 2);
+  }
+}
+
 TEST(WallNeighbors, HistoryFollowsParticleIdsAcrossReordering) {
   ParticleStore s = cloud(200, 5);
   WallPrimitive floor;
