@@ -577,7 +577,8 @@ void Subdomain::reduce_split(std::size_t n) {
   // and the lists only.
   constexpr double kReduceCost = 1.5;
   const int nt = threads();
-  std::vector<std::size_t> cuts = {0, n};
+  std::vector<std::size_t>& cuts = split_cuts_;  // members: no allocation per step
+  cuts.assign({0, n});
   for (int t = 1; t < nt; ++t) {
     const ThreadScratch& ts = scratch_[static_cast<std::size_t>(t)];
     for (std::size_t c : {ts.lo, ts.own_lo, ts.own_hi, ts.hi}) cuts.push_back(std::min(c, n));
@@ -591,7 +592,8 @@ void Subdomain::reduce_split(std::size_t n) {
         if (k >= lo && k < hi) w += kReduceCost;
     return w;
   };
-  std::vector<double> seg_w(cuts.size() - 1);
+  std::vector<double>& seg_w = split_weights_;
+  seg_w.resize(cuts.size() - 1);
   for (std::size_t c = 0; c + 1 < cuts.size(); ++c) seg_w[c] = weight(cuts[c]);
   // The cost of the particles [0, k): non-decreasing in k.
   auto cost_below = [&](std::size_t k) {

@@ -253,6 +253,8 @@ class Subdomain {
   std::vector<uint32_t> wall_work_particle_;  ///< refresh_wall_work: wall-list entries' particles, ascending
   std::vector<double> wall_work_sum_ = {0.0};  ///< and the running sum of their costs (one longer)
   std::vector<std::pair<uint32_t, double>> wall_work_scratch_;
+  std::vector<std::size_t> split_cuts_;       ///< reduce_split's segment bounds and weights
+  std::vector<double> split_weights_;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   static constexpr std::size_t kReorderMinParticles = 5000;
   std::size_t reorder_every_ = 20;  ///< list builds between spatial re-orderings (0: never)

@@ -39,6 +39,20 @@ std::set<std::pair<std::uint64_t, std::uint64_t>> brute(const ParticleStore& s, 
   return out;
 }
 
+/// Mark every `every`-th pair of the list live, with a history row that
+/// encodes its ids (tag, tag + 1, tag + 2); returns the tags by id pair.
+std::map<std::pair<std::uint64_t, std::uint64_t>, double> mark_live(NeighborList& nl, const ParticleStore& s,
+                                                                    std::size_t every) {
+  std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
+  for (std::size_t k = 0; k < nl.size(); k += every) {
+    const double tag = static_cast<double>(s.id[nl.i[k]] * 100000 + s.id[nl.j[k]]);
+    nl.touching[k] = 1;
+    for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
+    expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
+  }
+  return expected;
+}
+
 }  // namespace
 
 TEST(NeighborList, FindsExactlyThePairsWithinCutoffOrientedByIds) {
@@ -142,14 +156,7 @@ TEST(NeighborList, HistorySurvivesRebuildAndReordering) {
   NeighborList nl;
   nl.configure(0.0008, 3);
   nl.build(s);
-  // mark every other pair as touching with a history that encodes its ids
-  std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
-  for (std::size_t k = 0; k < nl.size(); k += 2) {
-    const double tag = static_cast<double>(s.id[nl.i[k]] * 10000 + s.id[nl.j[k]]);
-    nl.touching[k] = 1;
-    for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
-    expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
-  }
+  const auto expected = mark_live(nl, s, 2);  // every other pair
   // reverse the store order, as a space-filling-curve sort would shuffle it
   std::vector<std::uint32_t> order(s.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(order.size() - 1 - k);
@@ -184,13 +191,7 @@ TEST(NeighborList, HistoryOfRemovedParticlesIsDroppedAndTheRestCarried) {
     nl.configure(0.0008, 3);
     ThreadPool pool(threads);
     nl.build(s, &pool);
-    std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
-    for (std::size_t k = 0; k < nl.size(); ++k) {
-      const double tag = static_cast<double>(s.id[nl.i[k]] * 100000 + s.id[nl.j[k]]);
-      nl.touching[k] = 1;
-      for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
-      expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
-    }
+    const auto expected = mark_live(nl, s, 1);
     std::vector<std::uint8_t> remove(s.size(), 0);
     for (std::size_t k = 0; k < s.size(); k += 7) remove[k] = 1;
     s.remove_marked(remove);
@@ -229,13 +230,7 @@ TEST(NeighborList, HistoryIsCarriedByRowWhenTheLayoutIsUnchanged) {
     nl.configure(0.0008, 3);
     ThreadPool pool(threads);
     nl.build(s, &pool);
-    std::map<std::pair<std::uint64_t, std::uint64_t>, double> expected;
-    for (std::size_t k = 0; k < nl.size(); k += 3) {
-      const double tag = static_cast<double>(s.id[nl.i[k]] * 100000 + s.id[nl.j[k]]);
-      nl.touching[k] = 1;
-      for (int c = 0; c < 3; ++c) nl.history[k * 3 + c] = tag + c;
-      expected[{s.id[nl.i[k]], s.id[nl.j[k]]}] = tag;
-    }
+    const auto expected = mark_live(nl, s, 3);
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> step(-0.0006, 0.0006);
     for (std::size_t k = 0; k < s.size(); ++k) {
