@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <tuple>
@@ -444,6 +445,10 @@ void Subdomain::pair_forces(bool defer_reduce) {
   const int nt = threads();
   const bool far = far_active_;
   const Accumulator direct{s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data()};
+  if (nt > 1) {
+    balance_pairs(nt);  // reads the threads' contact counts of the last evaluation
+    thread_zones(far);
+  }
   for (auto& ts : scratch_) {
     ts.n_contacts = 0;
     ts.max_ratio = 0.0;
@@ -464,8 +469,6 @@ void Subdomain::pair_forces(bool defer_reduce) {
     // (reduce_partials): the same floating-point sums every run for a given
     // thread count.
     const std::size_t n = s.size();
-    balance_pairs(nt);
-    thread_zones(far);
     pool_->run([&](int t) {
       const std::size_t q = static_cast<std::size_t>(t);
       ThreadScratch& ts = scratch_[q];
@@ -490,9 +493,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
     }
   }
   last_contacts_ = 0;
-  thread_contacts_.clear();
   for (const auto& ts : scratch_) {
-    thread_contacts_.push_back(ts.n_contacts);
     last_contacts_ += ts.n_contacts;
     last_max_overlap_ratio_ = std::max(last_max_overlap_ratio_, ts.max_ratio);
   }
@@ -542,15 +543,15 @@ void Subdomain::refresh_wall_work() {
   // pass-2 range holds it. They sit where the walls are, at one end of the
   // spatially ordered store (a floor: the first particles), so they weigh in
   // the split. Per wall-list entry: its gap test, and for a contact the
-  // batch gather, the contact kernels and the scatter. Kept as (particle,
-  // cost) in particle order with running sums, refreshed with the pair
-  // split (balance_pairs): after each list build and every kBalanceEvery
-  // steps. Only the split depends on it, never a result.
+  // batch gather, the contact kernels and the scatter; a particle's kick
+  // costs 1 (weights from the measured pass-1 imbalance on S2 at 10k,
+  // docs/performance.md). Kept as (particle, cost of the entries up to this
+  // one) in particle order, refreshed with the pair split (balance_pairs):
+  // after each list build and every kBalanceEvery steps. Only the split
+  // depends on it, never a result.
   constexpr double kWallEntryCost = 1.0;
   constexpr double kWallContactCost = 6.0;
-  wall_work_particle_.clear();
-  wall_work_sum_.assign(1, 0.0);
-  std::vector<std::pair<uint32_t, double>>& ev = wall_work_scratch_;
+  std::vector<std::pair<uint32_t, double>>& ev = wall_work_;
   ev.clear();
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     if (!walls_now_[w].active(time_)) continue;
@@ -561,10 +562,7 @@ void Subdomain::refresh_wall_work() {
     std::inplace_merge(ev.begin(), ev.begin() + mid, ev.end(),
                        [](const auto& x, const auto& y) { return x.first < y.first; });
   }
-  for (const auto& [k, cost] : ev) {
-    wall_work_particle_.push_back(k);
-    wall_work_sum_.push_back(wall_work_sum_.back() + cost);
-  }
+  for (std::size_t e = 1; e < ev.size(); ++e) ev[e].second += ev[e - 1].second;  // costs -> running sums
 }
 
 void Subdomain::reduce_split(std::size_t n) {
@@ -600,8 +598,9 @@ void Subdomain::reduce_split(std::size_t n) {
     double sum = 0.0;
     for (std::size_t c = 0; c + 1 < cuts.size() && cuts[c] < k; ++c)
       sum += static_cast<double>(std::min(k, cuts[c + 1]) - cuts[c]) * seg_w[c];
-    const auto walls = std::lower_bound(wall_work_particle_.begin(), wall_work_particle_.end(), k);
-    return sum + wall_work_sum_[static_cast<std::size_t>(walls - wall_work_particle_.begin())];
+    const auto walls = std::lower_bound(wall_work_.begin(), wall_work_.end(), k,
+                                        [](const auto& w, std::size_t p) { return w.first < p; });
+    return sum + (walls == wall_work_.begin() ? 0.0 : std::prev(walls)->second);
   };
   const double total = cost_below(n);
   pass2_split_.assign(static_cast<std::size_t>(nt) + 1, n);
@@ -673,12 +672,12 @@ void Subdomain::balance_pairs(int nt) {
   constexpr double kRebalanceAt = 0.01;
   const std::size_t tiers[3] = {0, nlist_.near_size(), nlist_.size()};
   if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == nlist_.builds()) {
-    if (steps_ % kBalanceEvery != 0 || thread_contacts_.size() != static_cast<std::size_t>(nt)) return;
+    if (steps_ % kBalanceEvery != 0) return;
     double lo = 0, hi = 0;
     for (std::size_t q = 0; q < static_cast<std::size_t>(nt); ++q) {
       std::size_t entries = split_[0][q + 1] - split_[0][q];
       if (far_active_) entries += split_[1][q + 1] - split_[1][q];
-      const double cost = static_cast<double>(entries + kContactCost * thread_contacts_[q]);
+      const double cost = static_cast<double>(entries + kContactCost * scratch_[q].n_contacts);
       lo = q == 0 ? cost : std::min(lo, cost);
       hi = q == 0 ? cost : std::max(hi, cost);
     }

@@ -81,11 +81,7 @@ class Subdomain {
     if (!contacts_counted_) count_contacts();
     return store_;
   }
-  const ParticleStore& store() const {
-    synchronize_logically_const();
-    if (!contacts_counted_) const_cast<Subdomain*>(this)->count_contacts();
-    return store_;
-  }
+  const ParticleStore& store() const { return const_cast<Subdomain*>(this)->store(); }  // see synchronize_logically_const
   /// Particle count (needs no synchronisation).
   std::size_t size() const { return store_.size(); }
   /// Finish the last step now (see store()); throws RuntimeError when a
@@ -243,16 +239,14 @@ class Subdomain {
   std::vector<double> partial_, tier_partial_;  ///< per-thread counts of the integration passes
   std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
   std::size_t split_builds_ = 0;
-  std::vector<std::size_t> thread_contacts_;  ///< per thread: pair contacts of the last force evaluation
   bool reduce_pending_ = false;
   bool contacts_counted_ = true;  ///< store_.contacts is up to date (count_contacts)
   bool kick_pending_ = false;  ///< the last step's second half kick is still to do (store())
   double pending_half_ = 0;    ///< its half time step
   double forces_time_ = 0;     ///< time_ at the last force evaluation (wall activity)
   std::vector<double> bad_partial_;  ///< per-thread counts of non-finite particles
-  std::vector<uint32_t> wall_work_particle_;  ///< refresh_wall_work: wall-list entries' particles, ascending
-  std::vector<double> wall_work_sum_ = {0.0};  ///< and the running sum of their costs (one longer)
-  std::vector<std::pair<uint32_t, double>> wall_work_scratch_;
+  /// refresh_wall_work: (particle, wall cost of the entries up to this one), ascending in particle
+  std::vector<std::pair<uint32_t, double>> wall_work_;
   std::vector<std::size_t> split_cuts_;       ///< reduce_split's segment bounds and weights
   std::vector<double> split_weights_;
   std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
