@@ -186,12 +186,37 @@ def steps():
     return (make_bed.NSETTLE, make_bed.NRUN) if DECK["name"] == "bed" else (NSETTLE, NRUN)
 
 
-def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
+def expected_particles(n):
+    """The particle count domel should report for requested N on the deck being run."""
     nx, ny, nz = make_s1.lattice_dims(n)
-    expected = n if DECK["name"] == "bed" else nx * ny * nz
-    nsettle, nrun = steps()
-    scen = (make_bed.scenario_file(n, DECK["bed_dir"], rolling) if DECK["name"] == "bed"
+    return n if DECK["name"] == "bed" else nx * ny * nz
+
+
+def deck_scenario(n, workdir, rolling="none"):
+    """Path of the domel scenario of the deck being run (DECK) for N and a rolling model (a bed must be prepared)."""
+    return (make_bed.scenario_file(n, DECK["bed_dir"], rolling) if DECK["name"] == "bed"
             else scenario_file(n, workdir, rolling))
+
+
+def summary_final(s):
+    """End-of-run physics from a parsed summary.json: contacts per particle, translational KE, list builds, history."""
+    res = {}
+    sds = s.get("subdomains") or []
+    if sds:
+        sd = sds[0]
+        fin = sd.get("final", {})
+        if "contacts" in fin and sd.get("particles"):
+            res["mean_contacts_per_particle"] = 2.0 * fin["contacts"] / sd["particles"]
+        res["ke_translational_final_J"] = fin.get("ke_translational_J")
+        res["neighbor_builds_total"] = sd.get("neighbor_list_builds")
+        res["history_bytes"] = (sd.get("memory_bytes") or {}).get("contact_history")
+    return res
+
+
+def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
+    expected = expected_particles(n)
+    nsettle, nrun = steps()
+    scen = deck_scenario(n, workdir, rolling)
     code = "domel" if threads == 1 else "domel_%dt" % threads
     outdir = os.path.join(workdir, "%s_N%d_r%d" % (code, n, rep))
     log = outdir + ".screen"
@@ -212,15 +237,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
         return row
     row.update(N_actual=s.get("particles"), timed_steps=tw.get("steps"), timed_wall_s=tw.get("wall_time_s"),
                particle_steps_per_s=tw.get("particle_steps_per_s"), peak_rss_bytes=s.get("peak_rss_bytes"))
-    sds = s.get("subdomains") or []
-    if sds:
-        sd = sds[0]
-        fin = sd.get("final", {})
-        if "contacts" in fin and sd.get("particles"):
-            row["mean_contacts_per_particle"] = 2.0 * fin["contacts"] / sd["particles"]
-        row["ke_translational_final_J"] = fin.get("ke_translational_J")
-        row["neighbor_builds_total"] = sd.get("neighbor_list_builds")
-        row["history_bytes"] = (sd.get("memory_bytes") or {}).get("contact_history")
+    row.update(summary_final(s))
     # domel has no CPU clock of its own around the timed steps: they are the last steps of the process, so
     # take the CPU time the process used in its last timed_wall_s seconds (sampled from /proc every 20 ms;
     # includes the few ms of summary writing and exit)
