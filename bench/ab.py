@@ -266,7 +266,7 @@ def print_tables(rows):
         lines = []
         for key in keys:
             c, k, v = same_state(rows, "timed", key)
-            if v != "identical":
+            if v not in ("identical", "no data"):
                 diff.append(key)
             lines.append([key[0], str(nact(rows, key)), str(key[2]), c, k, v])
         run_s1.print_md(["case", "N", "threads", "contacts/particle old / new", "KE [J] old / new", "verdict"], lines)
@@ -365,9 +365,13 @@ def main(argv=None):
             print("  WARNING: libraries outside the binary's own tree: %s" % ", ".join(foreign))
     if os.path.realpath(args.old) == os.path.realpath(args.new):
         print("note: old and new are the same file (a smoke test or a noise measurement)")
-    print("cases %s, sizes %s, threads %s, %d rep(s) each binary; %scallgrind; logs in %s" % (
-        " ".join(args.cases), " ".join(map(str, args.sizes)), " ".join(map(str, args.threads)), args.reps,
-        "" if args.callgrind else "no ", workdir))
+    print("cases %s; %s; %s; logs in %s" % (
+        " ".join(args.cases),
+        ("timed: sizes %s, threads %s, %d rep(s) per binary" % (" ".join(map(str, args.sizes)),
+                                                              " ".join(map(str, args.threads)), args.reps))
+        if args.reps else "no timed runs",
+        ("callgrind: N = %d, %d steps, 1 thread" % (args.callgrind_size, args.callgrind_steps))
+        if args.callgrind else "no callgrind", workdir))
     if bad_plugins:
         print("a binary could not list its plugins; the runs may fail", file=sys.stderr)
 
