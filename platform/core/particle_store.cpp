@@ -21,6 +21,8 @@ void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, doub
   inv_inertia.push_back(fixed ? 0.0 : 1.0 / inertia);
   contacts.push_back(0);
   flags.push_back(fixed ? kFixed : 0);
+  if (external_force_)
+    for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->push_back(0.0);
   ++layout_version;
 }
 

@@ -23,6 +23,11 @@ struct ParticleStore {
   std::vector<double> inv_inertia;         ///< 1/I, I = 2/5 m r^2 for a solid sphere [1/(kg m^2)]
   std::vector<std::uint32_t> contacts;     ///< contact count in the last force evaluation
   std::vector<std::uint8_t> flags;         ///< kFixed, ...
+  /// External force per particle [N] (controllers, fluid drag): the second
+  /// entry of the body-force list (integrator.hpp), added to m g at every
+  /// force reset. Empty until enable_external_force(); from then on it moves
+  /// with the particles like every other array, and new particles get 0.
+  std::vector<double> ext_fx, ext_fy, ext_fz;
 
   /// A fixed particle is never moved (inverse mass and inertia 0, so the
   /// integrator leaves it at rest) but is a full contact partner with its real
@@ -31,6 +36,14 @@ struct ParticleStore {
   bool fixed(std::size_t k) const { return (flags[k] & kFixed) != 0; }
 
   std::size_t size() const { return id.size(); }
+
+  bool has_external_force() const { return external_force_; }
+  /// Give every particle an external force, 0 to start with. Idempotent.
+  void enable_external_force() {
+    if (external_force_) return;
+    for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(size(), 0.0);
+    external_force_ = true;
+  }
 
   /// Incremented by every change of which particle sits in which slot (add,
   /// swap_remove, permute), so that index-based structures (neighbour lists)
@@ -70,6 +83,9 @@ struct ParticleStore {
     f(id); f(x); f(y); f(z); f(vx); f(vy); f(vz); f(wx); f(wy); f(wz);
     f(fx); f(fy); f(fz); f(tx); f(ty); f(tz);
     f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts); f(flags);
+    if (external_force_) {
+      f(ext_fx); f(ext_fy); f(ext_fz);
+    }
   }
   template <class F>
   void for_each_array(F&& f) const {
@@ -82,6 +98,9 @@ struct ParticleStore {
     for_each_array([&b](const auto& v) { b += v.capacity() * sizeof(v[0]); });
     return b;
   }
+
+ private:
+  bool external_force_ = false;
 };
 
 }  // namespace domel::platform

@@ -812,6 +812,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
         });
         spdlog::info("subdomain '{}': {} particles from {} (contact history starts at zero)", sd_name, rows,
                      f.string());
+        sub->set_initial_source("the state file '" + f.string() + "' (" + base + "/initial_state)");
       } catch (const std::exception& e) {
         ck.add(base + "/initial_state", e.what());
       }
@@ -990,7 +991,6 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
     sim->subdomains.push_back(std::move(sub));
   }
   sim->flow.next_id = next_id;
-  for (int a = 0; a < 3; ++a) sim->flow.gravity[a] = sim->gravity[a];
   sim->flow.deletion_interval = run.value("deletion_interval", 0.005);
   if (doc.contains("deletion_regions"))
     for (const auto& d : doc["deletion_regions"]) {

@@ -100,12 +100,12 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
     st.add(id, x[q], y[q], z[q], r[q], p.density, p.fixed);
     const std::size_t k = st.size() - 1;
     st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
-    st.fx[k] = st.mass[k] * gravity[0]; st.fy[k] = st.mass[k] * gravity[1]; st.fz[k] = st.mass[k] * gravity[2];
     p.inserted_mass += st.mass[k];
     accounts_[p.subdomain].inserted += mass_units(st.mass[k]);
     ++accounts_[p.subdomain].n_inserted;
     ++taken;
   }
+  sd.apply_body_forces(st.size() - taken, st.size());  // their first half kick sees their body forces
   p.inserted += taken;
   const double deficit = target - p.inserted_mass;
   if (deficit > 0 && p.mass_rate * p.interval > 0) {

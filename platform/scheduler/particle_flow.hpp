@@ -98,7 +98,6 @@ class ParticleFlow {
   std::vector<MassFlowPlane> planes;
   double deletion_interval = 0.005;  ///< [s] between deletion (and plane) checks
   std::uint64_t next_id = 1;         ///< id of the next inserted particle
-  double gravity[3] = {0, 0, -9.81};
 
   bool empty() const { return pours.empty() && deletions.empty() && planes.empty(); }
 

@@ -1,23 +1,32 @@
 // SPDX-License-Identifier: MIT
 // One resolution level: its particle store, coarse-grain ratio, material,
-// contact model (slot pipeline), neighbour lists and time step. The per-step
-// hot path lives here and reads top to bottom:
-//   step(): half kick -> drift -> (rebuild lists) -> forces -> half kick
-//   compute_forces(): gravity, particle pairs in batches, walls in batches.
+// contact model (slot pipeline), neighbour lists, walls and time step, and
+// the orchestration of its step through the named phases of
+// step_phases.hpp. The work itself lives in the pieces it calls:
+//   integrator.hpp       half kicks, drift, the body-force list
+//   contact_sweep.hpp    pair and wall contacts (one gather/scatter)
+//   force_partition.hpp  the threads' share of a force evaluation and its sum
+//   time_step.hpp        the time-step estimate from the contact model
+//   diagnostics.hpp      statistics, memory, contact counts
 // Subdomains of one scenario do not touch each other's particles; coupling
-// operators (a later stage) exchange cell averages between them.
+// operators exchange cell averages between them through hooks.
 #pragma once
 
 #include "averaging/cell_grid.hpp"
 #include "contact/contact_pipeline.hpp"
+#include "contact/contact_sweep.hpp"
+#include "contact/time_step.hpp"
 #include "core/material.hpp"
 #include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
 #include "core/thread_pool.hpp"
 #include "geometry/wall.hpp"
 #include "geometry/wall_neighbors.hpp"
+#include "subdomain/diagnostics.hpp"
+#include "subdomain/force_partition.hpp"
+#include "subdomain/integrator.hpp"
+#include "subdomain/step_phases.hpp"
 
-#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -25,42 +34,6 @@
 #include <vector>
 
 namespace domel::platform {
-
-/// Observables of the last force evaluation and the current state.
-struct SubdomainStats {
-  std::size_t particles = 0;         ///< all particles, fixed ones included
-  std::size_t fixed = 0;             ///< fixed particles (not in the kinetic statistics)
-  std::size_t contacts = 0;          ///< particle-particle contacts
-  std::size_t wall_contacts = 0;
-  double kinetic_translational = 0;  ///< [J]
-  double kinetic_rotational = 0;     ///< [J]
-  double mean_angular_speed = 0;     ///< mean |omega| [rad/s]
-  /// median |omega| [rad/s]: robust against the few particles that spin
-  /// freely about their contact normal, which rolling models do not resist
-  /// and which pin the plain mean (peers/RESULTS.md §2)
-  double median_angular_speed = 0;
-  /// mean |omega| over particles with |omega| < 1 rad/s [rad/s] (the peers' trimmed statistic)
-  double trimmed_mean_angular_speed = 0;
-  double max_overlap_ratio = 0;      ///< max delta / (mean diameter of the pair), walls: delta / d
-};
-
-/// Bytes held by a subdomain's per-particle and per-contact arrays (their
-/// capacity), for the run summary and the memory benchmark.
-struct MemoryUse {
-  std::size_t particles = 0;        ///< the particle store
-  std::size_t neighbor_lists = 0;   ///< pair and wall lists without their history
-  std::size_t contact_history = 0;  ///< per-entry history rows of the pair and wall lists
-  std::size_t threads = 0;          ///< the other threads' force arrays
-};
-
-struct TimeStepReport {
-  double rayleigh = 0;       ///< Rayleigh time of the smallest particle [s]
-  double contact_time = 0;   ///< shortest simulated collision at the impact velocity [s]
-  double critical = 0;       ///< explicit stability limit 2/omega (damped) of the stiffest contact [s]
-  std::string critical_of;   ///< which contact sets it ("particle-particle", "wall 'x'")
-  double chosen = 0;         ///< [s]
-  std::string reason;
-};
 
 class Subdomain {
  public:
@@ -76,11 +49,7 @@ class Subdomain {
   /// state); not for concurrent use from several threads.
   /// Its per-particle `contacts` are counted here, from the lists' contact
   /// flags, once per force evaluation (no work in the step loop).
-  ParticleStore& store() {
-    synchronize();
-    if (!contacts_counted_) count_contacts();
-    return store_;
-  }
+  ParticleStore& store();
   const ParticleStore& store() const { return const_cast<Subdomain*>(this)->store(); }  // see synchronize_logically_const
   /// Particle count (needs no synchronisation).
   std::size_t size() const { return store_.size(); }
@@ -92,6 +61,9 @@ class Subdomain {
   void set_environment(const std::vector<Material>& materials, const std::vector<PairCoefficients>& wall_pairs,
                        const PairCoefficients& self_pair, const std::vector<WallPrimitive>* walls,
                        const double gravity[3]);
+  /// Where the initial particles came from (a state file), for the message
+  /// when their initial forces are not finite (setup()).
+  void set_initial_source(std::string source) { initial_source_ = std::move(source); }
   void set_skin(double skin) { skin_ = skin; }
   /// Re-order the store by spatial cells every `builds` neighbour-list
   /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
@@ -105,26 +77,38 @@ class Subdomain {
   int threads() const { return pool_->size(); }
   double time_step() const { return dt_; }
 
-  /// Estimate contact time and stability limit from the contact model itself:
-  /// a head-on collision at `impact_velocity` is integrated with the normal
-  /// and damping stages (particle-particle and each wall).
+  /// The body-force list (gravity; the store's external forces once enabled).
+  const BodyForces& body_forces() const { return body_forces_; }
+  /// Reset the forces of particles [first, last) to their body forces: for
+  /// particles added between steps (pours, inflow), so that their first
+  /// half kick sees the same forces as every other particle's.
+  void apply_body_forces(std::size_t first, std::size_t last);
+
+  /// Register a hook on a phase of every following step (step_phases.hpp).
+  /// From then on each step completes in phase order.
+  void add_hook(Phase phase, StepHook hook);
+  const StepHooks& hooks() const { return hooks_; }
+
+  /// Estimate contact time and stability limit from the contact model itself
+  /// (contact/time_step.hpp).
   TimeStepReport estimate_time_step(double impact_velocity);
 
-  /// Build neighbour lists and evaluate forces at the current state.
+  /// Build neighbour lists and evaluate forces at the current state. Throws
+  /// RuntimeError when those forces are not finite (coinciding particles).
   void setup();
   /// One velocity-Verlet step of dt, complete on return.
   void step() {
     step_deferred();
     synchronize();
   }
-  /// One velocity-Verlet step of dt that leaves its second half kick (and,
-  /// with threads, the last force sums and the wall contacts) pending: the
-  /// next step does them in its first sweep over the store, which saves one
-  /// sweep and one fork/join per step (docs/performance.md). store(),
-  /// stats(), contact_records() and synchronize() finish it, so every
-  /// observer that goes through them sees the complete step; a reference to
-  /// the store kept from before does not. The run loop uses this; code that
-  /// holds on to the store across steps uses step().
+  /// One velocity-Verlet step of dt. Without hooks it leaves its second
+  /// half kick (and, with threads, the last force sums and the wall
+  /// contacts) pending: the next step does them in its first sweep over the
+  /// store, which saves one sweep and one fork/join per step
+  /// (docs/performance.md). store(), stats(), contact_records() and
+  /// synchronize() finish it, so every observer that goes through them sees
+  /// the complete step; a reference to the store kept from before does not.
+  /// With hooks the step completes in phase order (bit-identical results).
   void step_deferred();
 
   double time() const { return time_; }
@@ -145,117 +129,75 @@ class Subdomain {
   /// contact_records()): the pending kick is an internal deferral, not
   /// observable state.
   void synchronize_logically_const() const { const_cast<Subdomain*>(this)->synchronize(); }
-  /// One thread's batch workspace, batch bookkeeping and force accumulators.
-  struct ThreadScratch {
-    std::unique_ptr<ContactPipeline::Workspace> ws;
-    std::vector<uint32_t> entry;     ///< list entry of each batch slot
-    std::vector<double> ci, cj;      ///< lever arms of each batch slot
-    std::vector<double> fx, fy, fz, tx, ty, tz;  ///< accumulators (threads > 0)
-    std::vector<ContactRecord> records;  ///< contact forces on recording steps
-    std::size_t n_contacts = 0;
-    std::size_t wall_contacts = 0;
-    double wall_max_ratio = 0;
-    std::size_t lo = 0, hi = 0;      ///< particle-index span of this thread's pairs this step
-    /// The part of [lo, hi) that no other thread's pairs touch this step:
-    /// forces on these particles go straight into the store (threads > 0;
-    /// own_lo == own_hi == hi when there is none). Only [lo, own_lo) and
-    /// [own_hi, hi) of the private arrays are cleared and summed.
-    std::size_t own_lo = 0, own_hi = 0;
-    /// The parts of the span that go through the private arrays.
-    std::array<std::pair<std::size_t, std::size_t>, 2> shared_ranges() const { return {{{lo, own_lo}, {own_hi, hi}}}; }
-    std::size_t span[2][2] = {{0, 0}, {0, 0}};  ///< the span per list tier (near, far)
-    double max_ratio = 0;
-    MeshScratch mesh;                ///< mesh walls: per-particle feature bookkeeping
-    std::vector<MeshContact> mesh_out;
-    std::vector<uint8_t> counted;
-  };
-  /// Where a thread adds forces: the store itself (thread 0) or its own arrays.
-  struct Accumulator {
-    double *fx, *fy, *fz, *tx, *ty, *tz;
-  };
+  /// The fused, deferred step (no hooks).
+  void step_fused();
+  /// The step in phase order, with its hooks.
+  void step_in_order();
+  void run_hooks(Phase phase);
+  /// Rethrow a kernel's failure with the subdomain, step and time.
+  [[noreturn]] void rethrow_with_context(const std::exception& e, const char* during) const;
 
   void rebuild_lists();
   /// Move the moving walls to time t; rebuild the list of a wall that became
   /// active or moved more than skin/2 since its build, clear a removed one's.
   void update_walls(double t);
-  void compute_forces();   ///< reset to gravity, then contact_forces()
+  /// Whether this step rebuilds the lists, from pass 1's counts; latches the
+  /// far tier's screening otherwise.
+  bool rebuild_due(bool stale);
   /// Add particle-pair and wall contact forces; with defer_reduce the other
-  /// threads' partial sums are left for the caller (reduce_partials).
-  void contact_forces(bool defer_reduce = false);
+  /// threads' partial sums and the wall contacts are left to the next pass.
+  void contact_forces(bool defer_reduce);
   void pair_forces(bool defer_reduce);
-  void reduce_partials(std::size_t first, std::size_t last);
-  void reduce_split(std::size_t n);
-  /// Wall-contact work per particle for reduce_split (with balance_pairs).
-  void refresh_wall_work();
-  void balance_pairs(int nt);
-  /// Forces on particles in [ts.own_lo, ts.own_hi) go to `own`, on the others
-  /// to `shared`; without kZoned all go to `own`. kTorque: the pipeline has
-  /// a rolling or twisting model, whose couples are added.
-  template <bool kZoned, bool kTorque>
-  void pair_range(std::size_t first, std::size_t last, ThreadScratch& ts, const Accumulator& own,
-                  const Accumulator& shared);
-  using PairRange = void (Subdomain::*)(std::size_t, std::size_t, ThreadScratch&, const Accumulator&,
-                                        const Accumulator&);
-  /// The pair_range instance for this pipeline, with or without zones.
-  PairRange pair_kernel(bool zoned) const;
-  /// Set lo/hi and own_lo/own_hi of every thread for this step (threads > 1).
-  void thread_zones(bool far);
-  /// The part of the last force evaluation left to the integration pass,
-  /// for thread t: with `reduce`, the other threads' sums and the wall
-  /// contacts of its particle range (pass2_split_). Returns that range.
+  void wall_forces();
+  PairSweep pair_sweep() const;
+  WallSweep wall_sweep();
+  /// The part of the last force evaluation left to the next pass, for thread
+  /// t: with `reduce`, the other threads' sums and the wall contacts of its
+  /// particle range. Returns that range.
   std::pair<std::size_t, std::size_t> finish_forces(int t, bool reduce, std::size_t n);
   /// Take the pending force sum, if any, and split the particles for it.
   bool take_pending_reduce(std::size_t n);
   void finish_wall_stats();
-  [[noreturn]] void throw_nonfinite() const;
-  void wall_forces();
+  [[noreturn]] void throw_nonfinite(const char* when, double t, std::uint64_t step) const;
   void prune_removed_walls();
-  /// Fill store_.contacts from the last force evaluation (store()).
-  void count_contacts();
-  void wall_range(ThreadScratch& ts, std::size_t first, std::size_t last);
 
   std::string name_;
   double coarse_grain_;
   std::size_t material_;
+  std::string initial_source_;
   std::unique_ptr<ContactPipeline> pipeline_;
   ParticleStore store_;
   NeighborList nlist_;
   std::vector<WallNeighbors> wall_lists_;
   const std::vector<WallPrimitive>* walls_ = nullptr;  ///< reference state (time 0) of the walls
   std::vector<WallPrimitive> walls_now_;  ///< this subdomain's walls placed at wall_time_
-  bool any_moving_ = false;
   double wall_time_ = 0;                  ///< time of the walls' placement and surface velocities
   std::vector<domel_pair_v1> wall_pairs_;
   domel_pair_v1 self_pair_{};
   Material own_material_;
-  double gravity_[3] = {0, 0, 0};
+  BodyForces body_forces_;
+  StepHooks hooks_;
   double skin_ = 0;
   double dt_ = 0;
   double time_ = 0;
   std::uint64_t steps_ = 0;
   std::size_t last_contacts_ = 0, last_wall_contacts_ = 0;
   double last_max_overlap_ratio_ = 0;
-  std::vector<ThreadScratch> scratch_;
-  std::vector<double> partial_, tier_partial_;  ///< per-thread counts of the integration passes
-  std::vector<std::size_t> split_[2];  ///< per list tier (near, far): ranges of the threads (balance_pairs)
-  std::size_t split_builds_ = 0;
+  std::vector<ContactScratch> scratch_;  ///< per thread
+  ForcePartition partition_;
+  std::vector<DriftCounts> drift_counts_;  ///< per thread, of pass 1
+  std::vector<double> nonfinite_counts_;   ///< per thread, of a second half kick
   bool reduce_pending_ = false;
   bool contacts_counted_ = true;  ///< store_.contacts is up to date (count_contacts)
   bool kick_pending_ = false;  ///< the last step's second half kick is still to do (store())
   double pending_half_ = 0;    ///< its half time step
   double forces_time_ = 0;     ///< time_ at the last force evaluation (wall activity)
-  std::vector<double> bad_partial_;  ///< per-thread counts of non-finite particles
-  /// refresh_wall_work: (particle, wall cost of the entries up to this one), ascending in particle
-  std::vector<std::pair<uint32_t, double>> wall_work_;
-  std::vector<std::size_t> split_cuts_;       ///< reduce_split's segment bounds and weights
-  std::vector<double> split_weights_;
-  std::vector<std::size_t> pass2_split_;  ///< particle ranges of the second half kick when it also reduces
   static constexpr std::size_t kReorderMinParticles = 5000;
   std::size_t reorder_every_ = 20;  ///< list builds between spatial re-orderings (0: never)
   std::size_t builds_since_reorder_ = SIZE_MAX / 2;  ///< re-order at the first build
   std::size_t reordered_size_ = 0;
-    bool walls_force_rebuild_ = false;  ///< a moving wall travelled skin/2 since its list was built
-  bool record_ = false;    ///< fill ThreadScratch::records (set_record_contacts)
+  bool walls_force_rebuild_ = false;  ///< a moving wall travelled skin/2 since its list was built
+  bool record_ = false;    ///< fill ContactScratch::records (set_record_contacts)
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::unique_ptr<ThreadPool> pool_;
 };

@@ -1,0 +1,363 @@
+// SPDX-License-Identifier: MIT
+// The pair and wall sweeps of contact_sweep.hpp, with their shared gather
+// (fill_slot) and scatter (load_of).
+#include "contact/contact_sweep.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <string>
+
+namespace domel::platform {
+
+ContactScratch::ContactScratch(const ContactPipeline& pipeline)
+    : ws(pipeline.make_workspace()),
+      entry(ContactPipeline::kBatchSize),
+      ci(ContactPipeline::kBatchSize),
+      cj(ContactPipeline::kBatchSize) {}
+
+namespace {
+
+// History rows are a few doubles (3 for Mindlin, 6 with a rolling model):
+// copy them inline; std::copy_n becomes a memmove call that costs more than
+// the copy itself at these sizes (perf: 6 % of a settle step).
+inline void copy_row(const double* __restrict src, double* __restrict dst, uint32_t n) {
+  switch (n) {
+    case 0: return;
+    case 1: dst[0] = src[0]; return;
+    case 2: dst[0] = src[0]; dst[1] = src[1]; return;
+    case 3: dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; return;
+    case 4: dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; dst[3] = src[3]; return;
+    case 5: dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; dst[3] = src[3]; dst[4] = src[4]; return;
+    case 6:
+      dst[0] = src[0]; dst[1] = src[1]; dst[2] = src[2]; dst[3] = src[3]; dst[4] = src[4]; dst[5] = src[5];
+      return;
+    default: std::copy_n(src, n, dst);
+  }
+}
+
+/// The batch arrays the gather fills.
+struct Slots {
+  double *overlap, *nx, *ny, *nz, *radius_i, *radius_j, *r_eff, *m_eff, *vn, *vtx, *vty, *vtz, *wx, *wy, *wz;
+  explicit Slots(ContactPipeline::Buffers& b)
+      : overlap(b.overlap.data()), nx(b.nx.data()), ny(b.ny.data()), nz(b.nz.data()),
+        radius_i(b.radius_i.data()), radius_j(b.radius_j.data()), r_eff(b.r_eff.data()), m_eff(b.m_eff.data()),
+        vn(b.vn.data()), vtx(b.vtx.data()), vty(b.vty.data()), vtz(b.vtz.data()), wx(b.wx.data()),
+        wy(b.wy.data()), wz(b.wz.data()) {}
+};
+
+/// The gather, shared by pairs and walls: slot q of the batch from the
+/// contact's geometry and the relative velocity (rx, ry, rz) of its contact
+/// points, split into the normal approach speed and the tangential part.
+inline void fill_slot(const Slots& b, uint32_t q, double delta, double nx, double ny, double nz, double ri,
+                      double rj, double r_eff, double m_eff, double rx, double ry, double rz, double wx, double wy,
+                      double wz) {
+  const double vdotn = rx * nx + ry * ny + rz * nz;
+  b.overlap[q] = delta;
+  b.nx[q] = nx; b.ny[q] = ny; b.nz[q] = nz;
+  b.radius_i[q] = ri;
+  b.radius_j[q] = rj;
+  b.r_eff[q] = r_eff;
+  b.m_eff[q] = m_eff;
+  b.vn[q] = -vdotn;
+  b.vtx[q] = rx - vdotn * nx; b.vty[q] = ry - vdotn * ny; b.vtz[q] = rz - vdotn * nz;
+  b.wx[q] = wx; b.wy[q] = wy; b.wz[q] = wz;
+}
+
+/// The velocity of a particle's contact point at lever arm s along n: v + s (w x n).
+inline void point_velocity(double vx, double vy, double vz, double wx, double wy, double wz, double s, double nx,
+                           double ny, double nz, double& ox, double& oy, double& oz) {
+  ox = vx + s * (wy * nz - wz * ny);
+  oy = vy + s * (wz * nx - wx * nz);
+  oz = vz + s * (wx * ny - wy * nx);
+}
+
+/// The scatter's arithmetic, shared by pairs and walls: the force on i,
+/// F = F_n n + F_t, and n x F_t, whose product with -c is the lever torque.
+struct Load {
+  double fx, fy, fz, cx, cy, cz;
+};
+inline Load load_of(double fn, double nx, double ny, double nz, double ftx, double fty, double ftz) {
+  return {fn * nx + ftx, fn * ny + fty, fn * nz + ftz, ny * ftz - nz * fty, nz * ftx - nx * ftz, nx * fty - ny * ftx};
+}
+
+/// A kernel failed on a batch: the same error, naming the batch's contacts
+/// by particle id (the first few; `partner` names the other side).
+template <class Partner>
+[[noreturn]] void throw_batch_failure(const PluginError& e, const ParticleStore& s, const uint32_t* entry,
+                                      uint32_t c, const uint32_t* particle_of_entry, Partner&& partner) {
+  constexpr uint32_t kShown = 4;
+  std::string what = std::string(e.what()) + "; the batch held " + std::to_string(c) + " contact(s): ";
+  for (uint32_t q = 0; q < std::min(c, kShown); ++q)
+    what += (q ? ", " : "") + std::string("particle id ") + std::to_string(s.id[particle_of_entry[entry[q]]]) +
+            " with " + partner(entry[q]);
+  if (c > kShown) what += ", ...";
+  throw PluginError(what);
+}
+
+// a - b and a + (-b) are the same IEEE operation, so both sides use one add
+inline void add(const ForceAccumulator& a, uint32_t k, double fx, double fy, double fz, double tx, double ty,
+                double tz) {
+  a.fx[k] += fx; a.fy[k] += fy; a.fz[k] += fz;
+  a.tx[k] += tx; a.ty[k] += ty; a.tz[k] += tz;
+}
+
+template <bool kZoned, bool kTorque>
+void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, ContactScratch& ts, std::size_t own_lo,
+                std::size_t own_hi, const ForceAccumulator& own, const ForceAccumulator& shared) {
+  const ParticleStore& s = *sw.store;
+  NeighborList& list = *sw.list;
+  auto& buf = ts.ws->buf;
+  const uint32_t stride = list.stride();
+  std::size_t contacts = 0;
+  double max_ratio = 0.0;
+
+  const uint32_t* __restrict li = list.i.data();
+  const uint32_t* __restrict lj = list.j.data();
+  uint8_t* __restrict touching = list.touching.data();
+  double* __restrict list_history = list.history.data();
+  const double* __restrict px = s.x.data(); const double* __restrict py = s.y.data();
+  const double* __restrict pz = s.z.data(); const double* __restrict pr = s.radius.data();
+  const double* __restrict pvx = s.vx.data(); const double* __restrict pvy = s.vy.data();
+  const double* __restrict pvz = s.vz.data();
+  const double* __restrict pwx = s.wx.data(); const double* __restrict pwy = s.wy.data();
+  const double* __restrict pwz = s.wz.data();
+  const double* __restrict pm = s.mass.data();
+  uint32_t* __restrict entry = ts.entry.data();
+  double* __restrict lever_i = ts.ci.data();
+  double* __restrict lever_j = ts.cj.data();
+  const Slots slots(buf);
+  double* __restrict b_hist = buf.history.data();
+  constexpr uint32_t kBatch = ContactPipeline::kBatchSize;
+  // unsigned k - zone_lo < zone_width: k in [own_lo, own_hi)
+  const auto zone_lo = static_cast<uint32_t>(own_lo);
+  const auto zone_width = static_cast<uint32_t>(own_hi - own_lo);
+  const ForceAccumulator own_acc = own, shared_acc = shared;
+
+  std::size_t e = first;
+  while (e < last) {
+    // Phase A: screen list entries for overlap, branch-free except for the
+    // rare contact that just opened, until a batch is full. Most entries of a
+    // Verlet list are not in contact (S1: ~5 of 6), so a data-dependent
+    // branch here mispredicts often.
+    uint32_t c = 0;
+    for (; e < last && c < kBatch; ++e) {
+      const uint32_t i = li[e], j = lj[e];
+      const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
+      const double rsum = pr[i] + pr[j];
+      const uint32_t in = (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
+      if (touching[e] > in) {  // the contact opened: its history ends
+        touching[e] = 0;
+        for (uint32_t h = 0; h < stride; ++h) list_history[e * stride + h] = 0.0;
+      }
+      entry[c] = static_cast<uint32_t>(e);
+      c += in;
+    }
+    if (c == 0) continue;
+    // Phase B: the gather (contact geometry and relative velocities).
+    for (uint32_t q = 0; q < c; ++q) {
+      const uint32_t le = entry[q];
+      const uint32_t i = li[le], j = lj[le];
+      const double ri = pr[i], rj = pr[j];
+      const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
+      const double rsum = ri + rj, inv_rsum = 1.0 / rsum;
+      const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const double inv = 1.0 / dist;
+      const double nx = dx * inv, ny = dy * inv, nz = dz * inv;
+      const double delta = rsum - dist;
+      const double ci = ri - 0.5 * delta, cj = rj - 0.5 * delta;
+      const double wix = pwx[i], wiy = pwy[i], wiz = pwz[i];
+      const double wjx = pwx[j], wjy = pwy[j], wjz = pwz[j];
+      double vix, viy, viz, vjx, vjy, vjz;
+      point_velocity(pvx[i], pvy[i], pvz[i], wix, wiy, wiz, -ci, nx, ny, nz, vix, viy, viz);
+      point_velocity(pvx[j], pvy[j], pvz[j], wjx, wjy, wjz, cj, nx, ny, nz, vjx, vjy, vjz);
+      // one division for R* and the overlap ratio
+      fill_slot(slots, q, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, pm[i] * pm[j] / (pm[i] + pm[j]),
+                vix - vjx, viy - vjy, viz - vjz, wix - wjx, wiy - wjy, wiz - wjz);
+      copy_row(list_history + static_cast<std::size_t>(le) * stride, b_hist + static_cast<std::size_t>(q) * stride,
+               stride);
+      touching[le] = 1;
+      lever_i[q] = ci;
+      lever_j[q] = cj;
+      max_ratio = std::max(max_ratio, delta * inv_rsum);
+    }
+    try {
+      sw.pipeline->evaluate(*ts.ws, *sw.pair, sw.dt, c);
+    } catch (const PluginError& err) {
+      throw_batch_failure(err, s, entry, c, li, [&](uint32_t le) { return "particle id " + std::to_string(s.id[lj[le]]); });
+    }
+    // The scatter: forces and torques onto both particles, history back to the list.
+    const double* __restrict fn_ = buf.fn.data();
+    const double* __restrict ftx_ = buf.ftx.data(); const double* __restrict fty_ = buf.fty.data();
+    const double* __restrict ftz_ = buf.ftz.data();
+    const double* __restrict tqx_ = buf.tqx.data(); const double* __restrict tqy_ = buf.tqy.data();
+    const double* __restrict tqz_ = buf.tqz.data();
+    for (uint32_t q = 0; q < c; ++q) {
+      const uint32_t le = entry[q];
+      const uint32_t i = li[le], j = lj[le];
+      const Load l = load_of(fn_[q], slots.nx[q], slots.ny[q], slots.nz[q], ftx_[q], fty_[q], ftz_[q]);
+      const double ci = lever_i[q], cj = lever_j[q];
+      double tix = -ci * l.cx, tiy = -ci * l.cy, tiz = -ci * l.cz;
+      double tjx = -cj * l.cx, tjy = -cj * l.cy, tjz = -cj * l.cz;
+      if constexpr (kTorque) {  // else the couple is zero, and adding it would change no bit (sums start at +0)
+        tix += tqx_[q]; tiy += tqy_[q]; tiz += tqz_[q];
+        tjx -= tqx_[q]; tjy -= tqy_[q]; tjz -= tqz_[q];
+      }
+      // A branch, not a select of the accumulator: it is taken the same way
+      // for all but the few particles of the band other threads share, and
+      // the own path keeps its pointers in registers (one writer: always).
+      if (!kZoned || i - zone_lo < zone_width) add(own_acc, i, l.fx, l.fy, l.fz, tix, tiy, tiz);
+      else add(shared_acc, i, l.fx, l.fy, l.fz, tix, tiy, tiz);
+      if (!kZoned || j - zone_lo < zone_width) add(own_acc, j, -l.fx, -l.fy, -l.fz, tjx, tjy, tjz);
+      else add(shared_acc, j, -l.fx, -l.fy, -l.fz, tjx, tjy, tjz);
+      copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
+               stride);
+    }
+    if (sw.record)
+      for (uint32_t q = 0; q < c; ++q) {
+        const uint32_t le = entry[q];
+        const Load l = load_of(fn_[q], slots.nx[q], slots.ny[q], slots.nz[q], ftx_[q], fty_[q], ftz_[q]);
+        ts.records.push_back({li[le], lj[le], l.fx, l.fy, l.fz, 0.0, 0.0, 0.0});
+      }
+    contacts += c;
+  }
+  ts.pair_contacts += contacts;
+  ts.pair_max_ratio = std::max(ts.pair_max_ratio, max_ratio);
+}
+
+}  // namespace
+
+PairRangeFn pair_kernel(bool has_torque, bool zoned) {
+  if (has_torque) return zoned ? &pair_range<true, true> : &pair_range<false, true>;
+  return zoned ? &pair_range<true, false> : &pair_range<false, false>;
+}
+
+void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std::size_t last) {
+  ParticleStore& s = *sw.store;
+  auto& buf = ts.ws->buf;
+  const Slots slots(buf);
+  const uint32_t stride = sw.pipeline->history_stride();
+  std::size_t contacts = 0;
+  double max_ratio = 0.0;
+  for (std::size_t w = 0; w < sw.lists->size(); ++w) {
+    WallNeighbors& list = (*sw.lists)[w];
+    const WallPrimitive& wall = (*sw.walls)[w];
+    // removed walls are pruned by the subdomain; the time of the force
+    // evaluation, as the walls' contacts may be finished in the next step
+    if (!wall.active(sw.forces_time)) continue;
+    const auto lo = std::lower_bound(list.particle.begin(), list.particle.end(), static_cast<uint32_t>(first));
+    const auto hi =
+        std::lower_bound(lo, list.particle.end(), static_cast<uint32_t>(std::min<std::size_t>(last, UINT32_MAX)));
+    const std::size_t e_first = static_cast<std::size_t>(lo - list.particle.begin());
+    const std::size_t e_last = static_cast<std::size_t>(hi - list.particle.begin());
+    uint32_t c = 0;
+    auto flush = [&]() {
+      if (c == 0) return;
+      try {
+        sw.pipeline->evaluate(*ts.ws, (*sw.pairs)[w], sw.dt, c);
+      } catch (const PluginError& err) {
+        throw_batch_failure(err, s, ts.entry.data(), c, list.particle.data(),
+                            [&](uint32_t) { return "wall '" + wall.name + "'"; });
+      }
+      for (uint32_t q = 0; q < c; ++q) {
+        const uint32_t e = ts.entry[q];
+        const uint32_t i = list.particle[e];
+        const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
+        const Load l = load_of(buf.fn[q], nx, ny, nz, buf.ftx[q], buf.fty[q], buf.ftz[q]);
+        s.fx[i] += l.fx; s.fy[i] += l.fy; s.fz[i] += l.fz;
+        const double ci = ts.ci[q];
+        s.tx[i] += -ci * l.cx + buf.tqx[q]; s.ty[i] += -ci * l.cy + buf.tqy[q]; s.tz[i] += -ci * l.cz + buf.tqz[q];
+        copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
+        if (sw.record)  // the contact point lies on the wall, ci from the centre along -n
+          ts.records.push_back({i, ContactRecord::kWall, l.fx, l.fy, l.fz, s.x[i] - ci * nx, s.y[i] - ci * ny,
+                                s.z[i] - ci * nz});
+      }
+      contacts += c;
+      c = 0;
+    };
+    // One contact into the batch: entry e of the list, particle i, centre
+    // distance d from the contact point, unit normal n (wall -> centre).
+    // The wall is partner j: no radius, no rotation, its surface velocity
+    // at the contact point x_i - c_i n when it moves.
+    const bool moving = wall.moving;
+    auto push = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
+      const double delta = s.radius[i] - d;
+      const double ci = s.radius[i] - delta;
+      double rx, ry, rz;
+      point_velocity(s.vx[i], s.vy[i], s.vz[i], s.wx[i], s.wy[i], s.wz[i], -ci, nx, ny, nz, rx, ry, rz);
+      if (moving) {
+        double ux, uy, uz;
+        wall.surface_velocity(sw.wall_time, s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
+        rx -= ux; ry -= uy; rz -= uz;
+      }
+      fill_slot(slots, c, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], rx, ry, rz, s.wx[i], s.wy[i],
+                s.wz[i]);
+      copy_row(list.history.data() + e * stride, buf.history.data() + c * stride, stride);
+      list.touching[e] = 1;
+      ts.entry[c] = static_cast<uint32_t>(e);
+      ts.ci[c] = ci;
+      max_ratio = std::max(max_ratio, delta / (2.0 * s.radius[i]));
+      if (++c == ContactPipeline::kBatchSize) flush();
+    };
+    if (wall.shape == WallPrimitive::Shape::mesh) {
+      // Per particle: the counted features of its candidate triangles
+      // (resolve_mesh_contacts). A contact that moves from one triangle to
+      // a neighbour (a sphere crossing a seam) keeps its history: a newly
+      // counted entry takes the history of an entry of the same particle
+      // that stopped counting this step.
+      for (std::size_t e = e_first; e < e_last;) {
+        const uint32_t i = list.particle[e];
+        std::size_t e_end = e + 1;
+        while (e_end < e_last && list.particle[e_end] == i) ++e_end;
+        const std::size_t count = e_end - e;
+        const double p[3] = {s.x[i], s.y[i], s.z[i]};
+        resolve_mesh_contacts(*wall.mesh, wall.verts.data(), p, s.radius[i], list.triangle.data() + e, count,
+                              ts.mesh, ts.mesh_out, wall.tri_bounds.empty() ? nullptr : wall.tri_bounds.data());
+        ts.counted.assign(count, 0);
+        for (const MeshContact& mc : ts.mesh_out) ts.counted[mc.slot] = 1;
+        std::size_t released = SIZE_MAX;
+        for (std::size_t k = 0; k < count; ++k) {
+          if (!list.touching[e + k] || ts.counted[k]) continue;
+          list.touching[e + k] = 0;
+          if (released == SIZE_MAX) released = e + k;
+          else std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>((e + k) * stride), stride, 0.0);
+        }
+        for (const MeshContact& mc : ts.mesh_out) {
+          const std::size_t entry = e + mc.slot;
+          if (!list.touching[entry] && released != SIZE_MAX) {
+            std::copy_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride,
+                        list.history.begin() + static_cast<std::ptrdiff_t>(entry * stride));
+            std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride, 0.0);
+            released = SIZE_MAX;
+          }
+          push(entry, i, mc.d, mc.n[0], mc.n[1], mc.n[2]);
+        }
+        if (released != SIZE_MAX)
+          std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride, 0.0);
+        e = e_end;
+      }
+      flush();
+      continue;
+    }
+    for (std::size_t e = e_first; e < e_last; ++e) {
+      const uint32_t i = list.particle[e];
+      double d, nx, ny, nz;
+      const bool has = wall.gap(s.x[i], s.y[i], s.z[i], d, nx, ny, nz);
+      if (!has || d >= s.radius[i]) {
+        if (list.touching[e]) {
+          list.touching[e] = 0;
+          std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(e * stride), stride, 0.0);
+        }
+        continue;
+      }
+      push(e, i, d, nx, ny, nz);
+    }
+    flush();
+  }
+  ts.wall_contacts += contacts;
+  ts.wall_max_ratio = std::max(ts.wall_max_ratio, max_ratio);
+}
+
+}  // namespace domel::platform

@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: MIT
+// The contact sweep: the contacts of a pair list and of the wall lists are
+// gathered into batches, evaluated by the slot pipeline, and scattered as
+// forces and torques. Pairs and walls share one gather (the contact points'
+// relative velocity into a batch slot) and one scatter (a slot's force and
+// lever-arm torque); they differ only in how a contact is found (a list
+// entry's overlap, a wall's gap) and in who receives the reaction.
+//
+// Contact geometry (docs/physics.md notation): n points from j to i,
+// overlap delta = R_i + R_j - |x_i - x_j|. The lever arm from a particle
+// centre to the contact point is c_i = R_i - delta/2 for a particle pair
+// (the middle of the overlap, as LIGGGHTS' c_ri) and c_i = R_i - delta for a
+// wall (the contact point lies on the wall surface).
+// Relative velocity of the contact points: v_c = (v_i + w_i x (-c_i n)) - (v_j + w_j x (c_j n)).
+// Forces: F_i = F_n n + F_t, F_j = -F_i. Torques: T_i = -c_i n x F_t + M,
+// T_j = -c_j n x F_t - M (M: rolling/twisting couple on i).
+//
+// Fields: reads the store's x, y, z, v, w, radius, mass; adds into the
+// accumulators' f and t; reads and writes the lists' touching flags and
+// history rows.
+#pragma once
+
+#include "averaging/cell_grid.hpp"
+#include "contact/contact_pipeline.hpp"
+#include "core/neighbor_list.hpp"
+#include "core/particle_store.hpp"
+#include "geometry/triangle_mesh.hpp"
+#include "geometry/wall.hpp"
+#include "geometry/wall_neighbors.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace domel::platform {
+
+/// Where a sweep adds forces and torques: the store itself or a thread's own arrays.
+struct ForceAccumulator {
+  double *fx, *fy, *fz, *tx, *ty, *tz;
+  static ForceAccumulator of(ParticleStore& s) {
+    return {s.fx.data(), s.fy.data(), s.fz.data(), s.tx.data(), s.ty.data(), s.tz.data()};
+  }
+};
+
+/// One thread's batch workspace and what its sweeps counted.
+struct ContactScratch {
+  explicit ContactScratch(const ContactPipeline& pipeline);
+  std::unique_ptr<ContactPipeline::Workspace> ws;
+  std::vector<uint32_t> entry;         ///< list entry of each batch slot
+  std::vector<double> ci, cj;          ///< lever arms of each batch slot
+  std::vector<ContactRecord> records;  ///< contact forces on recording steps
+  std::size_t pair_contacts = 0;
+  double pair_max_ratio = 0;
+  std::size_t wall_contacts = 0;
+  double wall_max_ratio = 0;
+  MeshScratch mesh;                    ///< mesh walls: per-particle feature bookkeeping
+  std::vector<MeshContact> mesh_out;
+  std::vector<uint8_t> counted;
+};
+
+/// The inputs of the pair sweep of one force evaluation.
+struct PairSweep {
+  const ParticleStore* store;
+  NeighborList* list;
+  const ContactPipeline* pipeline;
+  const domel_pair_v1* pair;
+  double dt;
+  bool record;  ///< append each contact's force to ContactScratch::records
+};
+
+/// The pair contacts of list entries [first, last). Forces on particles in
+/// [own_lo, own_hi) go to `own`, on the others to `shared`; without kZoned
+/// all go to `own`. kTorque: the pipeline has a rolling or twisting model,
+/// whose couples are added.
+using PairRangeFn = void (*)(const PairSweep&, std::size_t first, std::size_t last, ContactScratch& ts,
+                             std::size_t own_lo, std::size_t own_hi, const ForceAccumulator& own,
+                             const ForceAccumulator& shared);
+/// The pair_range instance for a pipeline (with or without a couple), with or without zones.
+PairRangeFn pair_kernel(bool has_torque, bool zoned);
+
+/// The inputs of the wall sweep of one force evaluation.
+struct WallSweep {
+  ParticleStore* store;
+  std::vector<WallNeighbors>* lists;
+  const std::vector<WallPrimitive>* walls;   ///< placed at wall_time
+  const std::vector<domel_pair_v1>* pairs;   ///< per wall
+  const ContactPipeline* pipeline;
+  double dt;
+  double forces_time;  ///< the force evaluation's time (which walls are active)
+  double wall_time;    ///< the walls' placement time (surface velocities)
+  bool record;
+};
+
+/// The wall contacts of the particles with index in [first, last), added
+/// straight into the store. Each touches one particle, so threads with
+/// disjoint particle ranges may run this at once. Wall lists are in index order.
+void wall_range(const WallSweep& sweep, ContactScratch& ts, std::size_t first, std::size_t last);
+
+}  // namespace domel::platform

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// The time step of a subdomain from its contact model: the Rayleigh time of
+// the smallest particle, the duration of a head-on collision at the impact
+// velocity and the explicit stability limit of the stiffest contact
+// (particle-particle and each wall; a rolling spring's own limit included),
+// all found by integrating a collision with the pipeline's own stages, so
+// a plugin's law sets its own step (docs/physics.md §1.3, §3.6).
+#pragma once
+
+#include "contact/contact_pipeline.hpp"
+#include "core/material.hpp"
+#include "core/particle_store.hpp"
+#include "geometry/wall.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace domel::platform {
+
+struct TimeStepReport {
+  double rayleigh = 0;       ///< Rayleigh time of the smallest particle [s]
+  double contact_time = 0;   ///< shortest simulated collision at the impact velocity [s]
+  double critical = 0;       ///< explicit stability limit 2/omega (damped) of the stiffest contact [s]
+  std::string critical_of;   ///< which contact sets it ("particle-particle", "wall 'x'")
+  double chosen = 0;         ///< [s]
+  std::string reason;
+};
+
+/// The contacts a time step is estimated for.
+struct TimeStepInputs {
+  ContactPipeline* pipeline;
+  const Material* material;
+  const domel_pair_v1* self_pair;
+  const std::vector<domel_pair_v1>* wall_pairs;  ///< per wall
+  const std::vector<WallPrimitive>* walls;       ///< names, for the report
+};
+
+/// Rayleigh time, contact time and stability limit for the smallest
+/// particle of `s` colliding at `impact_velocity` (chosen and reason left
+/// empty). Throws PluginError when a stage fails.
+TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore& s, double impact_velocity);
+
+/// What is wrong with a given time step, and how to fix it (empty: nothing).
+struct TimeStepProblem {
+  std::string message, hint;
+  explicit operator bool() const { return !message.empty(); }
+};
+
+/// Fill rep.chosen and rep.reason. A given step is checked against the
+/// stability limit; without one the choice is min(0.2 x Rayleigh time,
+/// contact time / 50, half the stability limit) (docs/physics.md §1.3).
+/// `estimated` is false when there was no particle to estimate with; a
+/// step must then be given.
+TimeStepProblem choose_time_step(const std::string& subdomain, TimeStepReport& rep, std::optional<double> given,
+                                 bool estimated, double impact_velocity);
+
+}  // namespace domel::platform
