@@ -5,7 +5,11 @@
 // cycles that would never descend into the instance. validate() then
 // interprets the schema directly, collecting every problem with a message
 // meant for people ("expected a number > 0 [Pa], found -3"); is_valid() runs
-// the same walk without messages and stops at the first problem.
+// the same walk without messages and stops at the first problem;
+// fill_defaults() walks it once more to write "default"s into an instance.
+// Over 600 lines because the three walks share the resolved schema, its $ref
+// table and the branch matching in one private State; split, they would need
+// that State in a header of its own.
 #include "scenario/json_schema.hpp"
 
 #include <algorithm>
@@ -28,8 +32,9 @@ const std::vector<std::string>& type_names() {
   return names;
 }
 
-// Accepted and ignored (their values are never looked at, except
-// "description" which is quoted in "missing required property" messages).
+// Accepted and ignored by validation (their values are never looked at,
+// except "description", quoted in "missing required property" messages, and
+// "default", which fill_defaults() writes into an instance).
 bool is_annotation(const std::string& k) {
   return k == "$schema" || k == "title" || k == "description" || k == "default" ||
          k == "examples" || k == "$comment";
@@ -727,6 +732,63 @@ struct SchemaValidator::State {
     return types;
   }
 
+  // ---- defaults -----------------------------------------------------------
+
+  // The "default" of a property schema, on it or on the node its $ref names.
+  const json* default_of(const json& s) const {
+    const json* node = &s;
+    for (int depth = 0; depth < 32 && node->is_object(); ++depth) {
+      if (auto d = node->find("default"); d != node->end()) return &*d;
+      auto r = node->find("$ref");
+      if (r == node->end()) break;
+      node = refs_.at(r->get_ref<const std::string&>());
+    }
+    return nullptr;
+  }
+
+  void fill(const json& s, json& v, const std::string& ptr, std::vector<std::string>& filled) const {
+    if (!s.is_object()) return;
+    if (v.is_object()) {
+      const auto props = s.find("properties");
+      if (props != s.end()) {
+        for (auto p = props->begin(); p != props->end(); ++p) {
+          if (v.contains(p.key())) continue;
+          if (const json* d = default_of(p.value())) {
+            v[p.key()] = *d;
+            filled.push_back(ptr + "/" + escape_token(p.key()));
+          }
+        }
+      }
+      const auto extra = s.find("additionalProperties");
+      for (auto it = v.begin(); it != v.end(); ++it) {
+        const std::string child = ptr + "/" + escape_token(it.key());
+        if (props != s.end()) {
+          if (auto p = props->find(it.key()); p != props->end()) {
+            fill(*p, it.value(), child, filled);
+            continue;
+          }
+        }
+        if (extra != s.end()) fill(*extra, it.value(), child, filled);
+      }
+    }
+    if (v.is_array()) {
+      if (auto items = s.find("items"); items != s.end())
+        for (std::size_t i = 0; i < v.size(); ++i) fill(*items, v[i], ptr + "/" + std::to_string(i), filled);
+    }
+    if (auto r = s.find("$ref"); r != s.end()) fill(*refs_.at(r->get_ref<const std::string&>()), v, ptr, filled);
+    if (auto all = s.find("allOf"); all != s.end())
+      for (const auto& b : *all) fill(b, v, ptr, filled);
+    for (const char* k : {"oneOf", "anyOf"}) {
+      auto alt = s.find(k);
+      if (alt == s.end()) continue;
+      const json* match = nullptr;
+      std::size_t matches = 0;
+      for (const auto& b : *alt)
+        if (eval(b, v, ptr, std::string(), nullptr) && ++matches == 1) match = &b;
+      if (matches == 1 || (matches > 1 && k[0] == 'a')) fill(*match, v, ptr, filled);
+    }
+  }
+
   // The "description" of a property schema, following $ref; may be empty.
   std::string description_of(const json& s) const {
     const json* node = &s;
@@ -764,6 +826,13 @@ void SchemaValidator::validate(const nlohmann::json& instance, std::vector<Diagn
 
 bool SchemaValidator::is_valid(const nlohmann::json& instance) const {
   return state_->eval(state_->root_, instance, std::string(), std::string(), nullptr);
+}
+
+std::vector<std::string> SchemaValidator::fill_defaults(nlohmann::json& instance,
+                                                       const std::string& base_pointer) const {
+  std::vector<std::string> filled;
+  state_->fill(state_->root_, instance, base_pointer, filled);
+  return filled;
 }
 
 const nlohmann::json& SchemaValidator::schema() const { return state_->root_; }

@@ -26,7 +26,8 @@ namespace domel::platform {
 /// schemas. Ignored: $schema, $id (root only), title, description, default,
 /// examples, $comment and every keyword starting with "x-" ("x-unit" is shown
 /// in bound messages unless it is "1", dimensionless; a unit on a schema is
-/// inherited through its $ref/allOf/anyOf/oneOf/not). A cycle of $ref, allOf,
+/// inherited through its $ref/allOf/anyOf/oneOf/not); "default" is used by
+/// fill_defaults(), never by validate(). A cycle of $ref, allOf,
 /// anyOf, oneOf or not that never descends into the instance is refused as
 /// malformed.
 ///
@@ -45,6 +46,17 @@ class SchemaValidator {
 
   /// True when validate() would report nothing (stops at the first problem).
   bool is_valid(const nlohmann::json& instance) const;
+
+  /// Writes the schema's "default" of every property the instance leaves
+  /// out into the instance, recursing into objects (properties,
+  /// additionalProperties), arrays (items) and through $ref and allOf; a
+  /// oneOf or anyOf contributes the one branch the instance matches (none when
+  /// it matches no branch or, for oneOf, several). A filled value is filled
+  /// in turn (a default object gets its own members' defaults). Meant for an
+  /// instance that validate() accepted: what it does to an invalid one is
+  /// unspecified but harmless. Returns the JSON pointers it filled
+  /// (base_pointer + path, RFC 6901 escaped), a filled object before its members.
+  std::vector<std::string> fill_defaults(nlohmann::json& instance, const std::string& base_pointer = "") const;
 
   /// The schema as given to the constructor.
   const nlohmann::json& schema() const;

@@ -5,8 +5,12 @@
 // scenario, (3) the platform schema, (4) each plugin block against the
 // schema of the model it names (unknown names get "did you mean" or the list
 // of valid names), (5) cross-references (materials, interactions, wall
-// shapes). Building then creates model instances, inserts particles and
-// checks each time step against the stability limit.
+// shapes). After pass (3) the schema's defaults are written into the
+// document, and each model block gets its model's defaults in pass (4), so
+// that the later passes and the builders (builders.cpp, one per block) read
+// every defaulted value from the document. Building then creates model
+// instances, inserts particles and checks each time step against the
+// stability limit.
 #pragma once
 
 #include "core/error.hpp"

@@ -31,6 +31,23 @@ double mass_kg(MassUnits u) {
   return static_cast<double>(whole) + static_cast<double>(frac) * 1e-18;
 }
 
+InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
+                                      double alpha, const ParticleStore* present) {
+  domel_insert_request_v1 req{};
+  req.struct_size = sizeof(req);
+  req.region = region;
+  req.seed = seed;
+  req.length_scale = alpha;
+  if (present) {
+    req.n_existing = present->size();
+    req.ex_x = present->x.data(); req.ex_y = present->y.data(); req.ex_z = present->z.data();
+    req.ex_r = present->radius.data();
+  }
+  InsertionCandidates c;
+  model.insert(req, c.x, c.y, c.z, c.r);
+  return c;
+}
+
 double FlowSeries::slope(double t0, double t1) const {
   double st = 0, sv = 0, stt = 0, stv = 0;
   std::size_t n = 0;
@@ -53,20 +70,26 @@ void ParticleFlow::start(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
   }
   for (auto& pl : planes) pl.side.assign(subdomains.size(), {});
   check_planes(subdomains);
-  next_check_ = deletion_interval;
+  const double macro = macro_step_of(subdomains);
+  checks_ = Interval(deletions.empty() ? 0.0 : deletion_interval, deletion_interval, macro);
+  for (auto& p : pours) p.schedule = Interval(p.interval, p.start, macro);
 }
 
 void ParticleFlow::update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains) {
-  if (!deletions.empty() && t >= next_check_ - 1e-12) {
+  if (checks_.take(t)) {
     check_planes(subdomains);  // count crossings before the crossed particles are deleted
     delete_particles(subdomains);
-    while (next_check_ <= t + 1e-12) next_check_ += deletion_interval;
   }
   for (auto& p : pours) {
-    const double due = p.start + static_cast<double>(p.events) * p.interval;
-    if (t + 1e-12 < due || t >= p.end || p.inserted_mass >= p.total_mass) continue;
+    if (!p.schedule.due(t) || t >= p.end || p.inserted_mass >= p.total_mass) continue;
     pour(p, t, *subdomains[p.subdomain]);
+    p.schedule.advance(t);
   }
+}
+
+void ParticleFlow::register_hooks(MacroHooks& hooks) {
+  if (empty()) return;
+  hooks.before.push_back([this](const MacroStep& step) { update(step.t, *step.subdomains); });
 }
 
 void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
@@ -77,27 +100,21 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   ++p.events;
   if (p.inserted_mass >= target) return;
   ParticleStore& st = sd.store();
-  domel_insert_request_v1 req{};
-  req.struct_size = sizeof(req);
-  req.region = p.region;
   // one seed per event: the pour's seed and the event count mixed with the
   // multiplier and increment of Knuth's MMIX linear congruential generator
-  req.seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
-  req.length_scale = p.alpha;
-  req.n_existing = st.size();
-  req.ex_x = st.x.data(); req.ex_y = st.y.data(); req.ex_z = st.z.data(); req.ex_r = st.radius.data();
-  std::vector<double> x, y, z, r;
+  const std::uint64_t seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
+  InsertionCandidates c;
   try {
-    p.model->insert(req, x, y, z, r);
+    c = request_insertion(*p.model, p.region, seed, p.alpha, &st);
   } catch (const PluginError& e) {
     throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
   }
   // The candidates are independent random draws in random order, so taking
   // them in order until the mass target is met keeps the size distribution.
   std::size_t taken = 0;
-  for (std::size_t q = 0; q < x.size() && p.inserted_mass < target; ++q) {
+  for (std::size_t q = 0; q < c.size() && p.inserted_mass < target; ++q) {
     const std::uint64_t id = next_id++;
-    st.add(id, x[q], y[q], z[q], r[q], p.density, p.fixed);
+    st.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.density, p.fixed);
     const std::size_t k = st.size() - 1;
     st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
     p.inserted_mass += st.mass[k];
@@ -114,7 +131,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
       p.warned = true;
       spdlog::warn("{}: the pour region held only {} free places at t = {:.4g} s; {:.3g} kg behind the rate of "
                    "{:.3g} kg/s (enlarge the region, raise the insertion's volume_fraction or shorten the interval)",
-                   p.where, x.size(), t, deficit, p.mass_rate);
+                   p.where, c.size(), t, deficit, p.mass_rate);
     }
   }
 }

@@ -12,11 +12,12 @@
 // Everything here runs between steps, never inside one: a pour or a removal
 // changes the store's layout, and the subdomain rebuilds its neighbour list
 // at its next step (ParticleStore::layout_version). Checks are therefore
-// batched at an interval (deletion regions: 0.005 s by default) so that a
+// batched at an interval (deletion regions: run.deletion_interval) so that a
 // steady outflow costs one list build per interval, not one per particle.
 #pragma once
 
 #include "loader/plugin_registry.hpp"
+#include "scheduler/schedule.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <nlohmann/json.hpp>
@@ -29,6 +30,19 @@
 #include <vector>
 
 namespace domel::platform {
+
+/// Candidate particles an insertion model placed (parcel radii, alpha applied).
+struct InsertionCandidates {
+  std::vector<double> x, y, z, r;
+  std::size_t size() const { return x.size(); }
+};
+
+/// The one way the platform asks an insertion model for particles, for the
+/// start-up insertion and for pours alike: fill `region` with the model's
+/// particles, radii scaled by alpha, avoiding the particles of `present`
+/// (none when null), with `seed`. Throws PluginError when the model fails.
+InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
+                                      double alpha, const ParticleStore* present);
 
 /// Exact mass in units of 1e-18 kg (sums in 128 bits).
 using MassUnits = __int128;
@@ -64,6 +78,7 @@ struct Pour {
   double interval = 0;      ///< [s] between insertion events
   std::uint64_t seed = 0;
   // state
+  Interval schedule;         ///< events due at start + k interval (set by ParticleFlow::start)
   std::uint64_t events = 0;
   std::uint64_t inserted = 0;
   double inserted_mass = 0;  ///< [kg]
@@ -96,15 +111,20 @@ class ParticleFlow {
   std::vector<Pour> pours;
   std::vector<DeletionRegion> deletions;
   std::vector<MassFlowPlane> planes;
-  double deletion_interval = 0.005;  ///< [s] between deletion (and plane) checks
-  std::uint64_t next_id = 1;         ///< id of the next inserted particle
+  double deletion_interval = 0;  ///< [s] between deletion (and plane) checks: run.deletion_interval
+  std::uint64_t next_id = 1;     ///< id of the next inserted particle
 
   bool empty() const { return pours.empty() && deletions.empty() && planes.empty(); }
 
-  /// Before the first step: every particle present counts as inserted.
+  /// Before the first step: every particle present counts as inserted; the
+  /// pours' and checks' intervals start (their tolerance from the
+  /// subdomains' macro step, schedule.hpp).
   void start(std::vector<std::unique_ptr<Subdomain>>& subdomains);
   /// At simulated time t (the start of a macro step): pours and checks that are due.
   void update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  /// Register update() as a before-macro-step hook (once, when not empty()).
+  /// The hook points at this object, which must outlive the hooks.
+  void register_hooks(MacroHooks& hooks);
   /// Plane crossings up to now (also called at every probe row and at the end).
   void check_planes(std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
@@ -121,7 +141,7 @@ class ParticleFlow {
   void delete_particles(std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
   std::vector<MassAccount> accounts_;
-  double next_check_ = 0;
+  Interval checks_;  ///< deletion (and plane) checks, every deletion_interval from deletion_interval on
   double last_row_t_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> last_row_;
 };

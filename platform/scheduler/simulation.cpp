@@ -22,13 +22,27 @@
 
 namespace domel::platform {
 
-double Simulation::macro_step() const {
-  double dt = 0;
-  for (const auto& sd : subdomains) dt = std::max(dt, sd->time_step());
-  return dt;
-}
+double Simulation::macro_step() const { return macro_step_of(subdomains); }
 
 namespace {
+
+/// The per-subdomain columns of probes.csv, "<subdomain>.<name>", in this
+/// order: one table gives both the header and the values of a row.
+struct ProbeColumn {
+  const char* name;
+  double (*value)(const SubdomainStats&);
+};
+const ProbeColumn kProbeColumns[] = {
+    {"particles", [](const SubdomainStats& s) { return static_cast<double>(s.particles); }},
+    {"ke_translational", [](const SubdomainStats& s) { return s.kinetic_translational; }},
+    {"ke_rotational", [](const SubdomainStats& s) { return s.kinetic_rotational; }},
+    {"mean_angular_speed", [](const SubdomainStats& s) { return s.mean_angular_speed; }},
+    {"median_angular_speed", [](const SubdomainStats& s) { return s.median_angular_speed; }},
+    {"trimmed_mean_angular_speed", [](const SubdomainStats& s) { return s.trimmed_mean_angular_speed; }},
+    {"max_overlap_ratio", [](const SubdomainStats& s) { return s.max_overlap_ratio; }},
+    {"contacts", [](const SubdomainStats& s) { return static_cast<double>(s.contacts); }},
+    {"wall_contacts", [](const SubdomainStats& s) { return static_cast<double>(s.wall_contacts); }},
+};
 
 std::string format_seconds(double s) {
   char buf[32];
@@ -60,7 +74,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const double macro = macro_step();
   std::vector<int> substeps;
   for (auto& sd : subdomains) {
-    const int n = std::max(1, static_cast<int>(std::ceil(macro / sd->time_step() - 1e-9)));
+    const int n = std::max(1, static_cast<int>(std::ceil(macro / sd->time_step() - kTimeTolerance)));
     if (std::fabs(macro / n - sd->time_step()) > 1e-12 * macro) {
       spdlog::info("subdomain '{}': time step adjusted from {:.6g} s to {:.6g} s = macro step / {}", sd->name(),
                    sd->time_step(), macro / n, n);
@@ -70,15 +84,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     sd->set_threads(threads_requested);
     sd->setup();
   }
-  const std::uint64_t total_macro = static_cast<std::uint64_t>(std::ceil(duration / macro - 1e-9));
+  const std::uint64_t total_macro = static_cast<std::uint64_t>(std::ceil(duration / macro - kTimeTolerance));
 
   // Outputs.
   std::vector<std::string> columns = {"time"};
   for (const auto& sd : subdomains)
-    for (const char* c : {"particles", "ke_translational", "ke_rotational", "mean_angular_speed",
-                          "median_angular_speed", "trimmed_mean_angular_speed", "max_overlap_ratio", "contacts",
-                          "wall_contacts"})
-      columns.push_back(sd->name() + "." + c);
+    for (const auto& c : kProbeColumns) columns.push_back(sd->name() + "." + c.name);
   if (repose_probe)
     for (const auto& sd : subdomains) columns.push_back(sd->name() + ".repose_angle_deg");
   for (const auto& c : flow.columns()) columns.push_back(c);
@@ -88,14 +99,14 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   grids.clear();
   std::vector<std::unique_ptr<io::CellGridVtkSeries>> grid_vtk;
   std::vector<std::unique_ptr<io::CellGridProfileCsv>> grid_csv;
-  std::vector<double> grid_next_write;
+  std::vector<Interval> grid_files;
   for (const auto& g : grid_setups) {
     grids.push_back(std::make_unique<CellGrid>(g.spec));
     grids.back()->set_accessible(walls, 0.0);
     grid_vtk.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridVtkSeries>(out, g.spec.name) : nullptr);
     grid_csv.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridProfileCsv>(out, g.spec.name, g.profile_axis)
                                                  : nullptr);
-    grid_next_write.push_back(g.spec.write_interval);
+    grid_files.emplace_back(g.spec.write_interval, g.spec.write_interval, macro);
   }
   auto step_subdomain = [&](std::size_t k) {
     Subdomain& sd = *subdomains[k];
@@ -126,13 +137,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   };
   auto write_grids = [&](double t, bool final) {
     for (std::size_t g = 0; g < grids.size(); ++g) {
-      if (!grid_vtk[g] || (!final && t < grid_next_write[g] - 1e-9 * macro)) continue;
+      if (!grid_vtk[g] || (!final && !grid_files[g].due(t))) continue;
       if (grids[g]->samples_pending() > 0) {
         const CellFields f = grids[g]->mean_since_last_take();
         grid_vtk[g]->write(t, *grids[g], f);
         grid_csv[g]->write(t, *grids[g], f);
       }
-      while (grid_next_write[g] <= t + 1e-9 * macro) grid_next_write[g] += grid_setups[g].spec.write_interval;
+      grid_files[g].advance(t);
     }
   };
   std::unique_ptr<io::CsvSeries> probes;
@@ -143,10 +154,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     std::vector<double> row = {t};
     for (const auto& sd : subdomains) {
       const SubdomainStats st = sd->stats();
-      row.insert(row.end(), {static_cast<double>(st.particles), st.kinetic_translational, st.kinetic_rotational,
-                             st.mean_angular_speed, st.median_angular_speed, st.trimmed_mean_angular_speed,
-                             st.max_overlap_ratio, static_cast<double>(st.contacts),
-                             static_cast<double>(st.wall_contacts)});
+      for (const auto& c : kProbeColumns) row.push_back(c.value(st));
     }
     if (repose_probe)
       for (const auto& sd : subdomains)
@@ -168,7 +176,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                "{} thread(s) -> {}",
                name, particles, subdomains.size(), duration, total_macro, macro, threads_requested, out.string());
 
-  double next_vtk = 0, next_probe = 0;
+  Interval probe_rows(probes ? probe_interval : 0.0, 0.0, macro);
+  Interval vtk_frames(vtk ? vtk_interval : 0.0, 0.0, macro);
+  MacroStep step;  // what the hooks see, updated in place
+  step.macro = macro;
+  step.subdomains = &subdomains;
   const auto start = std::chrono::steady_clock::now();
   auto last_report = start;
   const bool tty = isatty(fileno(stderr));
@@ -179,15 +191,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const std::uint64_t stop = options.max_steps ? std::min(options.max_steps, total_macro) : total_macro;
   for (;; ++m) {
     const double t = static_cast<double>(m) * macro;
-    if (!flow.empty() && m < stop) flow.update(t, subdomains);
-    if (probes && t >= next_probe - 1e-9 * macro) {
-      write_probes(t);
-      next_probe += probe_interval;
+    if (m < stop && !hooks.before.empty()) {
+      step.t = t;
+      step.index = m;
+      MacroHooks::run(hooks.before, step);
     }
-    if (vtk && t >= next_vtk - 1e-9 * macro) {
-      write_vtk(t);
-      next_vtk += vtk_interval;
-    }
+    if (probe_rows.take(t)) write_probes(t);
+    if (vtk_frames.take(t)) write_vtk(t);
     if (!grids.empty() && m > 0) {
       write_grids(t, false);
       refresh_accessible(t);
@@ -199,6 +209,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       const double ps = static_cast<double>(substeps[k]) * static_cast<double>(subdomains[k]->size());
       particle_steps += ps;
       if (options.time_after && m >= options.time_after) window_particle_steps += ps;
+    }
+    if (!hooks.after.empty()) {
+      step.t = static_cast<double>(m + 1) * macro;
+      step.index = m;
+      MacroHooks::run(hooks.after, step);
     }
     const auto now = std::chrono::steady_clock::now();
     const double since = std::chrono::duration<double>(now - last_report).count();

@@ -10,6 +10,7 @@
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scheduler/particle_flow.hpp"
+#include "scheduler/schedule.hpp"
 #include "subdomain/repose_probe.hpp"
 #include "subdomain/subdomain.hpp"
 
@@ -42,13 +43,19 @@ struct RunResult {
 
 class Simulation {
  public:
+  Simulation() = default;
+  // hooks hold pointers into this object (the particle flow registers its
+  // own member): it stays where it was built
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
   std::string name;
   std::filesystem::path scenario_file;
   std::vector<Material> materials;
   std::vector<WallPrimitive> walls;
   std::vector<std::unique_ptr<Subdomain>> subdomains;
   std::vector<TimeStepReport> time_steps;  ///< per subdomain
-  double gravity[3] = {0, 0, -9.81};
+  double gravity[3] = {0, 0, 0};  ///< [m/s^2] the scenario's (its schema default when omitted)
   double duration = 0;
   std::uint64_t seed = 1;
   int threads = 0;  ///< the scenario's run.threads; 0: not given (DOMEL_THREADS, else 1)
@@ -59,6 +66,10 @@ class Simulation {
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
   ParticleFlow flow;           ///< pours, deletion regions, mass-flow planes, mass balance
+  /// Run before and after every macro step (schedule.hpp): the particle flow
+  /// registers here when the scenario has pours, deletions or planes, and so
+  /// will couplings between levels.
+  MacroHooks hooks;
   /// Eulerian cell grids (output.grids): each averages one subdomain's
   /// particles every `every` of its steps; the latest fields are readable by
   /// controllers and couplers during the run (CellGrid::latest()).

@@ -27,7 +27,7 @@ struct SubdomainStats {
   double mean_angular_speed = 0;     ///< mean |omega| [rad/s]
   /// median |omega| [rad/s]: robust against the few particles that spin
   /// freely about their contact normal, which rolling models do not resist
-  /// and which pin the plain mean (peers/RESULTS.md §2)
+  /// and which pin the plain mean (docs/validation/repose.md)
   double median_angular_speed = 0;
   /// mean |omega| over particles with |omega| < 1 rad/s [rad/s] (the peers' trimmed statistic)
   double trimmed_mean_angular_speed = 0;

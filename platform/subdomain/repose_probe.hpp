@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Angle-of-repose probe: the slope of a heap's free surface, measured the
-// way the peers' analysis does (shared/peers/analysis/repose_analysis.py,
-// "pooled" fit) so that numbers compare directly:
+// way the peers' repose analysis does (its "pooled" fit; docs/validation/repose.md)
+// so that numbers compare directly:
 //  - mobile particles only; height h = z + r - base_height;
 //  - horizontal centre = centroid (x, y) of the particles;
 //  - square xy cells of side cell * d (d = mean diameter), surface height of

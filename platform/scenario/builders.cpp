@@ -1,0 +1,481 @@
+// SPDX-License-Identifier: MIT
+// The construction of a Simulation from a validated scenario whose schema
+// defaults have been filled in (scenario.cpp, fill_defaults): one builder per
+// scenario block, run in the order the blocks depend on each other --
+// materials and interactions, walls, the run settings, the subdomains (each:
+// contact pipeline, initial state, insertions, pours, skin, time step), the
+// particle flow, the cell grids and the outputs. Every value with a schema
+// default is read from the document without a fallback here; a key without
+// one is optional and tested with contains(). Every problem becomes a
+// Diagnostic; build() throws them all at once, before anything is written.
+#include "geometry/region.hpp"
+#include "geometry/triangle_mesh.hpp"  // MeshError
+#include "io/particle_state.hpp"
+#include "scenario/scenario.hpp"
+#include "scenario/scenario_detail.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <set>
+
+namespace domel::platform::scenario_detail {
+
+namespace {
+
+
+/// What the builders share while they work through the document.
+struct Build {
+  const json& doc;
+  const std::filesystem::path& file;
+  PluginRegistry& registry;
+  Simulation& sim;
+  Checker ck;
+  std::map<std::string, std::size_t> mat_index;
+  std::map<std::pair<std::string, std::string>, PairCoefficients> coeffs;
+  std::uint64_t next_id = 1;  ///< id of the next particle made
+};
+
+void build_materials(Build& b) {
+  for (auto& [name, m] : b.doc["materials"].items()) {
+    Material mat;
+    mat.name = name;
+    mat.density = m.contains("density") ? m["density"].get<double>() : 0.0;  // absent: a wall-only material
+    mat.youngs_modulus = m["youngs_modulus"].get<double>();
+    mat.poisson_ratio = m["poisson_ratio"].get<double>();
+    b.mat_index[name] = b.sim.materials.size();
+    b.sim.materials.push_back(mat);
+  }
+  for (const auto& it : b.doc["interactions"]) {
+    // std::minmax returns references: bind the names first (temporaries would dangle)
+    const std::string x = it["materials"][0].get<std::string>(), y = it["materials"][1].get<std::string>();
+    const std::pair<std::string, std::string> key = std::minmax(x, y);
+    b.coeffs[key] = {it["restitution"].get<double>(), it["friction"].get<double>()};
+  }
+}
+
+void build_walls(Build& b) {
+  if (!b.doc.contains("walls")) return;
+  for (const auto& w : b.doc["walls"]) {
+    try {
+      auto prims = expand_wall(w, b.mat_index.at(w["material"].get<std::string>()), b.file);
+      b.sim.walls.insert(b.sim.walls.end(), prims.begin(), prims.end());
+    } catch (const MeshError& e) {  // the file changed since validation
+      b.ck.add("/walls", e.what());
+    }
+  }
+}
+
+/// The scenario's name, gravity, seed and thread count (the run's length is
+/// read by build_outputs(), once the macro step is known).
+void build_run(Build& b) {
+  const json& run = b.doc["run"];
+  b.sim.name = b.doc.contains("name") ? b.doc["name"].get<std::string>() : b.file.stem().string();
+  for (int a = 0; a < 3; ++a) b.sim.gravity[a] = b.doc["gravity"][a].get<double>();
+  b.sim.seed = run["seed"].get<std::uint64_t>();
+  // no schema default: absent means $DOMEL_THREADS, else 1, decided at run time (Simulation::run)
+  b.sim.threads = run.contains("threads") ? run["threads"].get<int>() : 0;
+}
+
+/// The models of a subdomain's five contact slots (every slot is in the
+/// document: omitted ones were filled with the schema's default model).
+/// Null when a model cannot be made (reported).
+std::unique_ptr<ContactPipeline> build_contact_pipeline(Build& b, const json& sd, const std::string& base,
+                                                        json& used) {
+  std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots;
+  bool ok = true;
+  for (std::size_t s = 0; s < kSlotCount; ++s) {
+    const json& block = sd["contact"][kSlotNames[s]];
+    const std::string model = block["model"].get<std::string>();
+    if (model == "none") continue;
+    const RegisteredModel* m = b.registry.find(kSlotKinds[s], model);
+    const std::string where = base + "/contact/" + kSlotNames[s];
+    if (!m) {  // a default the loaded plugins do not provide
+      b.ck.add(where, std::string("no ") + kSlotNames[s] + " model '" + model + "' is loaded",
+               suggest(model, b.registry.names(kSlotKinds[s])));
+      ok = false;
+      continue;
+    }
+    try {
+      slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), "");
+    } catch (const PluginError& e) {
+      b.ck.add(where, e.what());
+      ok = false;
+      continue;
+    }
+    used[kSlotNames[s]] = {{"model", model},
+                           {"version", m->version},
+                           {"library", b.registry.libraries()[m->library].name},
+                           {"library_version", b.registry.libraries()[m->library].version}};
+  }
+  if (!ok) return nullptr;
+  return std::make_unique<ContactPipeline>(std::move(slots));
+}
+
+/// A subdomain's particles from its initial_state file.
+void build_initial_state(Build& b, Subdomain& sub, const json& sd, const std::string& base, double density) {
+  if (!sd.contains("initial_state")) return;
+  const std::filesystem::path f = scenario_path(b.file, sd["initial_state"].get<std::string>());
+  try {
+    ParticleStore& st = sub.store();
+    // streamed into the store, which is sized from the file's line count
+    // first (an upper bound): no copy of the rows, no doubling slack
+    st.reserve(st.size() + io::count_lines(f));
+    const std::size_t rows = io::for_each_particle_state_row(f, [&](const io::ParticleStateRow& p) {
+      st.add(b.next_id++, p.x, p.y, p.z, p.radius, density, p.fixed);
+      if (p.fixed) return;  // a fixed particle stays at rest
+      st.vx.back() = p.vx; st.vy.back() = p.vy; st.vz.back() = p.vz;
+      st.wx.back() = p.wx; st.wy.back() = p.wy; st.wz.back() = p.wz;
+    });
+    spdlog::info("subdomain '{}': {} particles from {} (contact history starts at zero)", sub.name(), rows,
+                 f.string());
+    sub.set_initial_source("the state file '" + f.string() + "' (" + base + "/initial_state)");
+  } catch (const std::exception& e) {
+    b.ck.add(base + "/initial_state", e.what());
+  }
+}
+
+/// An insertion block (subdomains[k].insert[q], subdomains[k].pour[q].insert)
+/// read once: its model instance and the platform keys around the plugin's
+/// parameters. Start-up insertion and pours both make theirs here and ask for
+/// particles through request_insertion().
+struct Inserter {
+  const RegisteredModel* registered = nullptr;
+  std::shared_ptr<ModelInstance> model;
+  domel_region_v1 region{};
+  double velocity[3] = {0, 0, 0};
+  bool fixed = false;
+  std::uint64_t seed = 0;
+};
+
+/// Throws PluginError when the plugin refuses its parameters. `derived_seed`
+/// is used when the block gives no seed.
+Inserter make_inserter(Build& b, const json& block, std::uint64_t derived_seed) {
+  Inserter ins;
+  ins.registered = b.registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
+  ins.model = std::make_shared<ModelInstance>(*ins.registered, plugin_params(block, DOMEL_KIND_INSERTION), "");
+  ins.region = make_region(block["region"]);
+  for (int a = 0; a < 3; ++a) ins.velocity[a] = block["velocity"][a].get<double>();
+  ins.fixed = block["fixed"].get<bool>();
+  ins.seed = block.contains("seed") ? block["seed"].get<std::uint64_t>() : derived_seed;
+  return ins;
+}
+
+/// Inserter seeds derive from the run seed, this hash of the subdomain's
+/// name and the inserter's position, so adding or removing another subdomain
+/// changes nothing here (FNV-1a).
+std::uint64_t name_hash(const std::string& name) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : name) h = (h ^ ch) * 1099511628211ull;
+  return h;
+}
+
+/// The start-up insertions, in order, after the initial state (whose
+/// particles they avoid).
+void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::string& base, double density) {
+  if (!sd.contains("insert")) return;
+  const std::uint64_t hash = name_hash(sub.name());
+  for (std::size_t q = 0; q < sd["insert"].size(); ++q) {
+    const json& block = sd["insert"][q];
+    const std::string where = idx(base + "/insert", q);
+    try {
+      const Inserter ins = make_inserter(b, block, b.sim.seed * 1000003ull + hash + q);
+      ParticleStore& st = sub.store();
+      const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st);
+      st.reserve(st.size() + c.size());
+      for (std::size_t p = 0; p < c.size(); ++p) {
+        st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], density, ins.fixed);
+        st.vx.back() = ins.velocity[0]; st.vy.back() = ins.velocity[1]; st.vz.back() = ins.velocity[2];
+      }
+      spdlog::info("subdomain '{}': inserted {} particles with '{}' ({})", sub.name(), c.size(), ins.registered->name,
+                   where);
+      if (c.size() == 0) spdlog::warn("subdomain '{}': {} inserted no particles", sub.name(), where);
+    } catch (const PluginError& e) {
+      b.ck.add(where, e.what());
+    }
+  }
+}
+
+/// The pours: their model instances live for the run; one dry event per pour
+/// (no particle present) gives the radii it will insert, appended to
+/// `pour_radii` for the skin and the time step of a subdomain that starts empty.
+void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& base, double density,
+                 std::vector<double>& pour_radii) {
+  if (!sd.contains("pour")) return;
+  const std::uint64_t hash = name_hash(sub.name());
+  const double* gravity = b.sim.gravity;
+  for (std::size_t q = 0; q < sd["pour"].size(); ++q) {
+    const json& pb = sd["pour"][q];
+    const std::string where = idx(base + "/pour", q);
+    try {
+      const Inserter ins = make_inserter(b, pb["insert"], b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
+      Pour p;
+      p.where = where;
+      p.subdomain = b.sim.subdomains.size();
+      p.model = ins.model;
+      p.region = ins.region;
+      for (int a = 0; a < 3; ++a) p.velocity[a] = ins.velocity[a];
+      p.fixed = ins.fixed;
+      p.seed = ins.seed;
+      p.density = density;
+      p.alpha = sub.coarse_grain();
+      p.mass_rate = pb["mass_rate"].get<double>();
+      if (pb.contains("total_mass")) p.total_mass = pb["total_mass"].get<double>();
+      p.start = pb["start"].get<double>();
+      if (pb.contains("end")) p.end = pb["end"].get<double>();
+      if (pb.contains("interval")) {
+        p.interval = pb["interval"].get<double>();
+      } else {
+        // no schema default: the time the inserted particles need to leave the region
+        const double speed = std::sqrt(p.velocity[0] * p.velocity[0] + p.velocity[1] * p.velocity[1] +
+                                       p.velocity[2] * p.velocity[2]);
+        const double g = std::sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]);
+        if (speed > 0) {
+          const double u[3] = {p.velocity[0] / speed, p.velocity[1] / speed, p.velocity[2] / speed};
+          p.interval = region_extent(p.region, u) / speed;
+        } else if (g > 0) {
+          const double u[3] = {gravity[0] / g, gravity[1] / g, gravity[2] / g};
+          p.interval = std::sqrt(2.0 * region_extent(p.region, u) / g);
+        } else {
+          p.interval = 0.01;
+        }
+      }
+      const InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr);
+      if (c.size() == 0) {
+        b.ck.add(where + "/insert", "the insertion model placed no particle in the pour region",
+                 "enlarge the region or raise the model's volume_fraction / count");
+        continue;
+      }
+      pour_radii.insert(pour_radii.end(), c.r.begin(), c.r.end());
+      double one_event = 0;
+      for (double rr : c.r) one_event += p.density * 4.0 / 3.0 * M_PI * rr * rr * rr;
+      spdlog::info("subdomain '{}': pour {} inserts {:.4g} kg/s with '{}' every {:.4g} s (one full region: {} "
+                   "particles, {:.4g} kg)",
+                   sub.name(), where, p.mass_rate, ins.registered->name, p.interval, c.size(), one_event);
+      if (one_event < p.mass_rate * p.interval)
+        spdlog::warn("{}: one filled pour region ({:.3g} kg) holds less than the mass of one interval ({:.3g} kg); "
+                     "the pour will fall behind its rate", where, one_event, p.mass_rate * p.interval);
+      b.sim.flow.pours.push_back(std::move(p));
+    } catch (const PluginError& e) {
+      b.ck.add(where + "/insert", e.what());
+    }
+  }
+}
+
+/// The subdomain's time step, estimated and chosen or checked by
+/// contact/time_step (with a pour's smallest particle present for the
+/// estimate). False when the subdomain cannot run (reported).
+bool set_time_step(Build& b, Subdomain& sub, const json& sd, const std::string& base,
+                   const std::vector<double>& pour_radii, double density, TimeStepReport& rep) {
+  Checker& ck = b.ck;
+  const std::string& sd_name = sub.name();
+  const double v_imp = sd["impact_velocity"].get<double>();
+  // a pour's smallest particle, present only for the estimate (the
+  // smallest particle sets the Rayleigh time)
+  const bool probe_particle = !pour_radii.empty();
+  if (probe_particle)
+    sub.store().add(0, 0.0, 0.0, 0.0, *std::min_element(pour_radii.begin(), pour_radii.end()), density);
+  try {
+    rep = sub.estimate_time_step(v_imp);
+  } catch (const PluginError& e) {
+    ck.add(base + "/contact", std::string("the contact model failed while estimating the time step: ") + e.what());
+    return false;
+  }
+  if (probe_particle) sub.store().swap_remove(sub.store().size() - 1);
+  const json& ts = sd["time_step"];
+  const std::optional<double> given = ts.is_number() ? std::optional<double>(ts.get<double>()) : std::nullopt;
+  if (const TimeStepProblem p =
+          choose_time_step(sd_name, rep, given, sub.store().size() > 0 || probe_particle, v_imp)) {
+    ck.add(base + "/time_step", p.message, p.hint);
+    return false;
+  }
+  sub.set_time_step(rep.chosen);
+  spdlog::info("subdomain '{}': {} particles, time step {:.4g} s ({}); Rayleigh time {:.4g} s, contact time {:.4g} s "
+               "at {:.3g} m/s, stability limit {:.4g} s ({})",
+               sd_name, sub.store().size(), rep.chosen, rep.reason, rep.rayleigh, rep.contact_time, v_imp,
+               rep.critical, rep.critical_of);
+  return true;
+}
+
+/// One subdomain: contact pipeline, particles (state file, insertions),
+/// pours, neighbour skin, time step.
+void build_subdomain(Build& b, std::size_t k) {
+  const json& sd = b.doc["subdomains"][k];
+  const std::string base = idx("/subdomains", k);
+  const std::string sd_name = sd["name"].get<std::string>();
+  const std::string mat_name = sd["material"].get<std::string>();
+  const double alpha = sd["coarse_grain"].get<double>();
+  const double density = b.sim.materials[b.mat_index.at(mat_name)].density;
+
+  json used = json::object();
+  auto pipeline = build_contact_pipeline(b, sd, base, used);
+  if (!pipeline) return;
+  b.sim.models_used[sd_name] = used;
+  auto sub = std::make_unique<Subdomain>(sd_name, alpha, b.mat_index.at(mat_name), std::move(pipeline));
+  std::vector<PairCoefficients> wall_coeffs;
+  for (const auto& w : b.sim.walls)
+    wall_coeffs.push_back(b.coeffs.at(std::minmax(mat_name, b.sim.materials[w.material].name)));
+  sub->set_environment(b.sim.materials, wall_coeffs, b.coeffs.at(std::minmax(mat_name, mat_name)), &b.sim.walls,
+                       b.sim.gravity);
+
+  const std::size_t problems_before_insert = b.ck.diags.size();
+  build_initial_state(b, *sub, sd, base, density);
+  build_insertions(b, *sub, sd, base, density);
+  std::vector<double> pour_radii;
+  build_pours(b, *sub, sd, base, density, pour_radii);
+  if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
+
+  // neighbour skin: fraction of the largest diameter
+  double rmax = 0;
+  for (double r : sub->store().radius) rmax = std::max(rmax, r);
+  for (double r : pour_radii) rmax = std::max(rmax, r);
+  sub->set_skin(sd["skin"].get<double>() * 2.0 * (rmax > 0 ? rmax : 1e-3));
+  sub->set_reorder_every(sd["reorder_every"].get<std::size_t>());
+
+  TimeStepReport rep;
+  if (!set_time_step(b, *sub, sd, base, pour_radii, density, rep)) return;
+  b.sim.time_steps.push_back(rep);
+  b.sim.subdomains.push_back(std::move(sub));
+}
+
+/// Deletion regions, mass-flow planes and the run's deletion interval; the
+/// flow registers its per-macro-step work on the simulation's hooks.
+void build_particle_flow(Build& b) {
+  ParticleFlow& flow = b.sim.flow;
+  flow.next_id = b.next_id;
+  flow.deletion_interval = b.doc["run"]["deletion_interval"].get<double>();
+  if (b.doc.contains("deletion_regions"))
+    for (const auto& d : b.doc["deletion_regions"]) {
+      DeletionRegion dr;
+      dr.name = d["name"].get<std::string>();
+      dr.region = make_region(d["region"]);
+      if (d.contains("rate_window"))
+        for (int a = 0; a < 2; ++a) dr.rate_window[a] = d["rate_window"][a].get<double>();
+      flow.deletions.push_back(dr);
+    }
+  const json& out = b.doc["output"];
+  if (out.contains("mass_flow"))
+    for (const auto& d : out["mass_flow"]) {
+      MassFlowPlane pl;
+      pl.name = d["name"].get<std::string>();
+      double len = 0;
+      for (int a = 0; a < 3; ++a) {
+        pl.p[a] = d["point"][a].get<double>();
+        pl.n[a] = d["normal"][a].get<double>();
+        len += pl.n[a] * pl.n[a];
+      }
+      for (int a = 0; a < 3; ++a) pl.n[a] /= std::sqrt(len);
+      if (d.contains("rate_window"))
+        for (int a = 0; a < 2; ++a) pl.rate_window[a] = d["rate_window"][a].get<double>();
+      flow.planes.push_back(pl);
+    }
+  flow.register_hooks(b.sim.hooks);
+}
+
+/// output.grids: the cell grids' specifications (their write interval, when
+/// not given, waits for the duration in build_outputs()).
+void build_grids(Build& b) {
+  const json& out = b.doc["output"];
+  if (!out.contains("grids")) return;
+  const json& gs = out["grids"];
+  for (std::size_t g = 0; g < gs.size(); ++g) {
+    const json& gj = gs[g];
+    Simulation::GridSetup setup;
+    setup.spec.name = gj["name"].get<std::string>();
+    for (int a = 0; a < 3; ++a) {
+      setup.spec.lo[a] = gj["min"][a].get<double>();
+      setup.spec.hi[a] = gj["max"][a].get<double>();
+      setup.spec.cells[a] = gj["cells"][a].get<int>();
+    }
+    setup.spec.every = gj["every"].get<int>();
+    setup.spec.write_interval = -1.0;  // not given: duration / 20, set in build_outputs()
+    if (gj.contains("write_interval")) setup.spec.write_interval = gj["write_interval"].get<double>();
+    setup.spec.accessible_samples = gj["accessible_samples"].get<int>();
+    setup.profile_axis = axis_index(&gj["profile_axis"]);
+    if (gj.contains("subdomain")) {
+      const std::string want = gj["subdomain"].get<std::string>();
+      std::vector<std::string> names;
+      bool found = false;
+      for (std::size_t k = 0; k < b.sim.subdomains.size(); ++k) {
+        names.push_back(b.sim.subdomains[k]->name());
+        if (names.back() == want) {
+          setup.subdomain = k;
+          found = true;
+        }
+      }
+      if (!found)
+        b.ck.add(idx("/output/grids", g) + "/subdomain", "unknown subdomain '" + want + "'", suggest(want, names));
+    } else if (b.sim.subdomains.size() > 1) {
+      b.ck.add(idx("/output/grids", g), "missing required property 'subdomain'",
+               "the scenario has more than one subdomain; name the one this grid averages");
+    }
+    bool corners = true;
+    for (int a = 0; a < 3; ++a)
+      if (setup.spec.hi[a] <= setup.spec.lo[a]) {
+        corners = false;
+        b.ck.add(idx("/output/grids", g) + "/max/" + std::to_string(a),
+                 "expected max > min along " + std::string(1, "xyz"[a]) + ", found max " + fmt_num(setup.spec.hi[a]) +
+                     " <= min " + fmt_num(setup.spec.lo[a]));
+      }
+    if (corners) try {
+        CellGrid probe(setup.spec);  // the grid's own checks
+      } catch (const std::invalid_argument& e) {
+        b.ck.add(idx("/output/grids", g), e.what());
+      }
+    for (std::size_t h = 0; h < g; ++h)
+      if (gs[h]["name"] == gj["name"])
+        b.ck.add(idx("/output/grids", g) + "/name", "duplicate grid name '" + setup.spec.name + "'");
+    b.sim.grid_setups.push_back(setup);
+  }
+}
+
+/// The run's length and the outputs. Intervals without a schema default are
+/// fractions of the duration, so this runs once the macro step is known.
+void build_outputs(Build& b) {
+  Simulation& sim = b.sim;
+  const json& run = b.doc["run"];
+  if (run.contains("duration")) {
+    sim.duration = run["duration"].get<double>();
+  } else {
+    sim.duration = static_cast<double>(run["steps"].get<std::uint64_t>()) * sim.macro_step();
+  }
+  const json& out = b.doc["output"];
+  sim.output_directory = out.contains("directory") ? out["directory"].get<std::string>() : sim.name + "_out";
+  sim.vtk_interval = out.contains("vtk_interval") ? out["vtk_interval"].get<double>() : sim.duration / 50.0;
+  sim.probe_interval = out.contains("probe_interval") ? out["probe_interval"].get<double>() : sim.duration / 500.0;
+  sim.write_state = out["state"].get<bool>();
+  for (auto& g : sim.grid_setups)
+    if (g.spec.write_interval < 0) g.spec.write_interval = sim.duration / 20.0;
+  if (out.contains("repose_angle")) {
+    const json& r = out["repose_angle"];
+    ReposeProbeSettings rp;
+    rp.base_height = r["base_height"].get<double>();
+    rp.cell = r["cell"].get<double>();
+    rp.band_lo = r["band"][0].get<double>();
+    rp.band_hi = r["band"][1].get<double>();
+    sim.repose_probe = rp;
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& file, PluginRegistry& registry) {
+  auto sim = std::make_unique<Simulation>();
+  sim->scenario_file = file;
+  Build b{doc, file, registry, *sim, Checker{file, {}}, {}, {}, 1};
+  build_materials(b);
+  build_walls(b);
+  build_run(b);
+  for (std::size_t k = 0; k < doc["subdomains"].size(); ++k) build_subdomain(b, k);
+  build_particle_flow(b);
+  build_grids(b);
+  if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);
+  build_outputs(b);
+  return sim;
+}
+
+}  // namespace domel::platform::scenario_detail

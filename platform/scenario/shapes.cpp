@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: MIT
+// Scenario shapes as the runtime sees them: a region block as the ABI's
+// domel_region_v1 (insertion, pours, deletion regions) and a wall block as
+// its wall primitives (a box is six planes, a cylinder a mantle plus its
+// bottom, lid and outlet plug, ...). Reads a validated document with its
+// schema defaults filled in.
+#include "geometry/triangle_mesh.hpp"
+#include "scenario/scenario_detail.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace domel::platform::scenario_detail {
+
+domel_region_v1 make_region(const json& region) {
+  domel_region_v1 r{};
+  r.struct_size = sizeof(domel_region_v1);
+  if (region.contains("box")) {
+    r.shape = 1;
+    for (int a = 0; a < 3; ++a) {
+      r.lo[a] = region["box"]["min"][a].get<double>();
+      r.hi[a] = region["box"]["max"][a].get<double>();
+      r.center[a] = 0.5 * (r.lo[a] + r.hi[a]);
+    }
+  } else {
+    const json& c = region["cylinder"];
+    r.shape = 2;
+    r.axis = static_cast<uint32_t>(axis_index(&c["axis"]));
+    r.radius = c["radius"].get<double>();
+    for (int a = 0; a < 3; ++a) {
+      r.center[a] = c["center"][a].get<double>();
+      r.lo[a] = r.center[a] - r.radius;
+      r.hi[a] = r.center[a] + r.radius;
+    }
+    r.lo[r.axis] = c["bottom"].get<double>();
+    r.hi[r.axis] = c["top"].get<double>();
+  }
+  return r;
+}
+
+namespace {
+
+std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material,
+                                             const std::filesystem::path& scenario_file) {
+  std::vector<WallPrimitive> out;
+  const std::string name = w["name"].get<std::string>();
+  const std::string type = w["type"].get<std::string>();
+  auto plane = [&](const std::string& n, const double p[3], const double nrm[3]) {
+    WallPrimitive prim;
+    prim.shape = WallPrimitive::Shape::plane;
+    prim.name = n;
+    prim.material = material;
+    const double len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    for (int a = 0; a < 3; ++a) { prim.p[a] = p[a]; prim.n[a] = nrm[a] / len; }
+    out.push_back(prim);
+  };
+  // the axis, centre and extent an axis-aligned mantle (cylinder, cone) shares
+  auto mantle = [&](WallPrimitive::Shape shape) {
+    WallPrimitive m;
+    m.shape = shape;
+    m.name = name + ".mantle";
+    m.material = material;
+    m.axis = axis_index(&w["axis"]);
+    for (int a = 0; a < 3; ++a) m.c[a] = w["center"][a].get<double>();
+    m.lo = w["bottom"].get<double>();
+    m.hi = w["top"].get<double>();
+    return m;
+  };
+  if (type == "plane") {
+    const double p[3] = {w["point"][0].get<double>(), w["point"][1].get<double>(), w["point"][2].get<double>()};
+    const double n[3] = {w["normal"][0].get<double>(), w["normal"][1].get<double>(), w["normal"][2].get<double>()};
+    plane(name, p, n);
+  } else if (type == "box") {
+    std::set<std::string> open;
+    if (w.contains("open"))
+      for (const auto& f : w["open"]) open.insert(f.get<std::string>());
+    const char* faces[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+    for (int f = 0; f < 6; ++f) {
+      if (open.count(faces[f])) continue;
+      const int a = f / 2;
+      const bool is_min = f % 2 == 0;
+      double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+      p[a] = (is_min ? w["min"] : w["max"])[a].get<double>();
+      n[a] = is_min ? 1.0 : -1.0;
+      plane(name + "." + faces[f], p, n);
+    }
+  } else if (type == "cylinder") {
+    WallPrimitive m = mantle(WallPrimitive::Shape::cylinder_inside);
+    m.radius = w["radius"].get<double>();
+    out.push_back(m);
+    double p[3] = {m.c[0], m.c[1], m.c[2]}, n[3] = {0, 0, 0};
+    // closed_bottom has no schema default: true for a cylinder, false for a cone
+    if (!w.contains("closed_bottom") || w["closed_bottom"].get<bool>()) {
+      p[m.axis] = m.lo; n[m.axis] = 1.0;
+      if (w.contains("outlet_radius")) {
+        // a plate with a round hole; until outlet_open_at a full plane plugs
+        // it (never both at once: the plug's remove_at is the annulus'
+        // active_from, so no particle feels two bottoms)
+        WallPrimitive a;
+        a.shape = WallPrimitive::Shape::annulus;
+        a.name = name + ".bottom";
+        a.material = material;
+        for (int k = 0; k < 3; ++k) { a.p[k] = p[k]; a.n[k] = n[k]; a.c[k] = p[k]; }
+        a.r_inner = w["outlet_radius"].get<double>();
+        if (w.contains("outlet_open_at")) {
+          const double t_open = w["outlet_open_at"].get<double>();
+          plane(name + ".plug", p, n);
+          out.back().remove_at = t_open;
+          a.active_from = t_open;
+        }
+        out.push_back(a);
+      } else {
+        plane(name + ".bottom", p, n);
+      }
+    }
+    if (w["closed_top"].get<bool>()) {
+      p[m.axis] = m.hi; n[m.axis] = -1.0;
+      plane(name + ".top", p, n);
+    }
+  } else if (type == "cone") {
+    WallPrimitive m = mantle(WallPrimitive::Shape::cone_inside);
+    m.radius = w["radius_bottom"].get<double>();
+    m.radius_hi = w["radius_top"].get<double>();
+    out.push_back(m);
+    if (w.contains("closed_bottom") && w["closed_bottom"].get<bool>()) {
+      WallPrimitive d;
+      d.shape = WallPrimitive::Shape::annulus;
+      d.name = name + ".plug";
+      d.material = material;
+      for (int k = 0; k < 3; ++k) { d.p[k] = m.c[k]; d.c[k] = m.c[k]; d.n[k] = 0.0; }
+      d.p[m.axis] = m.lo;
+      d.c[m.axis] = m.lo;
+      d.n[m.axis] = 1.0;
+      d.r_inner = 0.0;
+      d.r_outer = m.radius;
+      if (w.contains("outlet_open_at")) d.remove_at = w["outlet_open_at"].get<double>();
+      out.push_back(d);
+    }
+  } else if (type == "disk") {
+    WallPrimitive d;
+    d.shape = WallPrimitive::Shape::annulus;
+    d.name = name;
+    d.material = material;
+    double len = 0;
+    for (int a = 0; a < 3; ++a) len += w["normal"][a].get<double>() * w["normal"][a].get<double>();
+    len = std::sqrt(len);
+    for (int a = 0; a < 3; ++a) {
+      d.p[a] = d.c[a] = w["center"][a].get<double>();
+      d.n[a] = w["normal"][a].get<double>() / len;
+    }
+    d.r_inner = w["inner_radius"].get<double>();
+    d.r_outer = w["radius"].get<double>();
+    out.push_back(d);
+  } else {  // mesh
+    const std::filesystem::path f = scenario_path(scenario_file, w["file"].get<std::string>());
+    double tr[3];
+    for (int a = 0; a < 3; ++a) tr[a] = w["translate"][a].get<double>();
+    auto mesh = std::make_shared<TriangleMesh>(load_stl_mesh(f, w["scale"].get<double>(), tr));
+    spdlog::info("wall '{}': {} triangles, {} vertices, {} edges from {} ({} corners welded{})", name,
+                 mesh->triangle_count(), mesh->vertex_count(), mesh->edge_count(), f.string(), mesh->welded,
+                 mesh->dropped_degenerate ? ", " + std::to_string(mesh->dropped_degenerate) + " degenerate triangles dropped"
+                                          : std::string());
+    WallPrimitive m;
+    m.shape = WallPrimitive::Shape::mesh;
+    m.name = name;
+    m.material = material;
+    m.verts = mesh->vertices;
+    triangle_bounds(*mesh, m.verts, m.tri_bounds);
+    m.mesh = std::move(mesh);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material, const std::filesystem::path& scenario_file) {
+  std::vector<WallPrimitive> out = expand_wall_shape(w, material, scenario_file);
+  if (w.contains("remove_at"))
+    for (auto& p : out) p.remove_at = std::min(p.remove_at, w["remove_at"].get<double>());
+  if (const json* mo = member(w, "motion")) {
+    const std::string type = w["type"].get<std::string>();
+    for (auto& p : out) {
+      p.moving = true;
+      for (int a = 0; a < 3; ++a) {
+        p.velocity[a] = (*mo)["velocity"][a].get<double>();
+        p.omega[a] = (*mo)["angular_velocity"][a].get<double>();
+        // default origin: the wall's own centre or point (on its rotation axis), 0 for a mesh
+        p.origin[a] = mo->contains("origin") ? (*mo)["origin"][a].get<double>()
+                      : type == "plane"      ? w["point"][a].get<double>()
+                      : w.contains("center") ? w["center"][a].get<double>()
+                                             : 0.0;
+      }
+      p.motion_start = (*mo)["start"].get<double>();
+      if (mo->contains("end")) p.motion_end = (*mo)["end"].get<double>();
+    }
+  }
+  return out;
+}
+
+
+}  // namespace domel::platform::scenario_detail
