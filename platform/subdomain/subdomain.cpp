@@ -78,7 +78,7 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
   // spheres: I/2; sphere on a wall: I), for the rolling spring's own limit
   // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
   // (docs/physics.md §3.6).
-  auto collide = [&](const domel_pair_v1& pair, double r_i, double r_j, double m_eff, double i_red,
+  auto collide = [&](const domel_pair_v2& pair, double r_i, double r_j, double m_eff, double i_red,
                      double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
     const double r_eff = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
@@ -91,6 +91,7 @@ TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
       auto force = [&](double d, double vel) {
         buf.overlap[0] = std::max(d, 1e-300);
         buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_i; buf.radius_j[0] = r_j;
+        buf.mass_i[0] = r_j > 0 ? 2.0 * m_eff : m_eff; buf.mass_j[0] = r_j > 0 ? 2.0 * m_eff : 0.0;  // equal spheres or a wall
         buf.nx[0] = 0; buf.ny[0] = 0; buf.nz[0] = 1; buf.vn[0] = vel;
         buf.vtx[0] = buf.vty[0] = buf.vtz[0] = 0; buf.wx[0] = buf.wy[0] = buf.wz[0] = 0;
         std::fill(buf.history.begin(), buf.history.end(), 0.0);
@@ -748,6 +749,7 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
   double* __restrict b_nz = buf.nz.data();
   double* __restrict b_ri = buf.radius_i.data(); double* __restrict b_rj = buf.radius_j.data();
   double* __restrict b_reff = buf.r_eff.data(); double* __restrict b_meff = buf.m_eff.data();
+  double* __restrict b_mi = buf.mass_i.data(); double* __restrict b_mj = buf.mass_j.data();
   double* __restrict b_vn = buf.vn.data();
   double* __restrict b_vtx = buf.vtx.data(); double* __restrict b_vty = buf.vty.data();
   double* __restrict b_vtz = buf.vtz.data();
@@ -815,6 +817,7 @@ void Subdomain::pair_range(std::size_t first, std::size_t last, ThreadScratch& t
       b_rj[q] = rj;
       b_reff[q] = ri * rj * inv_rsum;  // one division for R* and the overlap ratio
       b_meff[q] = pm[i] * pm[j] / (pm[i] + pm[j]);
+      b_mi[q] = pm[i]; b_mj[q] = pm[j];
       b_vn[q] = -vdotn;
       b_vtx[q] = rx - vdotn * nx; b_vty[q] = ry - vdotn * ny; b_vtz[q] = rz - vdotn * nz;
       b_wx[q] = wix - wjx; b_wy[q] = wiy - wjy; b_wz[q] = wiz - wjz;
@@ -971,6 +974,7 @@ void Subdomain::wall_range(ThreadScratch& ts, std::size_t first, std::size_t las
       buf.radius_j[c] = 0.0;
       buf.r_eff[c] = s.radius[i];
       buf.m_eff[c] = s.mass[i];
+      buf.mass_i[c] = s.mass[i]; buf.mass_j[c] = 0.0;
       buf.vn[c] = -vdotn;
       buf.vtx[c] = rx - vdotn * nx; buf.vty[c] = ry - vdotn * ny; buf.vtz[c] = rz - vdotn * nz;
       buf.wx[c] = s.wx[i]; buf.wy[c] = s.wy[i]; buf.wz[c] = s.wz[i];

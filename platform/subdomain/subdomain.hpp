@@ -225,8 +225,8 @@ class Subdomain {
   std::vector<WallPrimitive> walls_now_;  ///< this subdomain's walls placed at wall_time_
   bool any_moving_ = false;
   double wall_time_ = 0;                  ///< time of the walls' placement and surface velocities
-  std::vector<domel_pair_v1> wall_pairs_;
-  domel_pair_v1 self_pair_{};
+  std::vector<domel_pair_v2> wall_pairs_;
+  domel_pair_v2 self_pair_{};
   Material own_material_;
   double gravity_[3] = {0, 0, 0};
   double skin_ = 0;
