@@ -773,7 +773,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
         continue;
       }
       try {
-        slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), "");
+        slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), "subdomain '" + sd_name + "'");
       } catch (const PluginError& e) {
         ck.add(where, e.what());
         ok = false;
@@ -822,7 +822,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
         const std::string where = idx(base + "/insert", q);
         const RegisteredModel* m = registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
         try {
-          ModelInstance inst(*m, plugin_params(block, DOMEL_KIND_INSERTION), "");
+          ModelInstance inst(*m, plugin_params(block, DOMEL_KIND_INSERTION), "subdomain '" + sd_name + "'");
           ParticleStore& st = sub->store();
           domel_insert_request_v1 req{};
           req.struct_size = sizeof(req);
@@ -866,7 +866,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
           Pour p;
           p.where = where;
           p.subdomain = sim->subdomains.size();
-          p.model = std::make_shared<ModelInstance>(*m, plugin_params(block, DOMEL_KIND_INSERTION), "");
+          p.model = std::make_shared<ModelInstance>(*m, plugin_params(block, DOMEL_KIND_INSERTION), "subdomain '" + sd_name + "'");
           p.region = make_region(block["region"]);
           if (block.contains("velocity"))
             for (int a = 0; a < 3; ++a) p.velocity[a] = block["velocity"][a].get<double>();
