@@ -160,9 +160,9 @@ inline void for_each_pair_run(domel_contact_batch_v2& b, F&& f) {
     sub.n = c1 - c0;
     sub.pair = p;
     sub.pair_of = b.pair_of + c0;
-    const double** in[] = {&sub.overlap, &sub.nx, &sub.ny, &sub.nz, &sub.r_eff, &sub.m_eff,
-                                 &sub.radius_i, &sub.radius_j, &sub.mass_i, &sub.mass_j, &sub.vn,
-                                 &sub.vtx, &sub.vty, &sub.vtz, &sub.wx, &sub.wy, &sub.wz};
+    const double** in[] = {&sub.overlap,  &sub.nx,       &sub.ny,     &sub.nz,     &sub.r_eff, &sub.m_eff,
+                           &sub.radius_i, &sub.radius_j, &sub.mass_i, &sub.mass_j, &sub.vn,    &sub.vtx,
+                           &sub.vty,      &sub.vtz,      &sub.wx,     &sub.wy,     &sub.wz};
     for (auto* q : in)
       if (*q) *q += c0;
     double** out[] = {&sub.fn_elastic, &sub.kn, &sub.kn_tangent, &sub.contact_radius, &sub.fn_damping,
