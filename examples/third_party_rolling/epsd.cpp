@@ -26,11 +26,16 @@
 //    before the tangential stage, as LIGGGHTS's cdata.Fn; a net attractive
 //    value counts as 0 (LIGGGHTS with limitForce).
 //  - The stored M_k is rotated into the current tangent plane (projected, its
-//    length kept) before the increment, so that it never acquires a twisting
-//    component. LIGGGHTS stores it unrotated.
-//  - I_r needs the two masses, the batch gives m* and the radii: see
-//    rolling_inertia() below.
+//    length kept: domel::sdk::tangent_keep_length) before the increment, so
+//    that it never acquires a twisting component. LIGGGHTS stores it
+//    unrotated.
+//  - mu_r is the material pair's rolling friction when the scenario sets one
+//    for the pair (domel_pair_v2::has_rolling_friction), else the model's
+//    "rolling_friction" parameter.
+//  - I_r from the two particles' masses and radii (mass_i, mass_j of the
+//    batch, ABI 2): see rolling_inertia() below.
 // History: 3 doubles, the spring torque M_k [N m].
+#include <domel/sdk/kinematics.hpp>
 #include <domel/sdk/plugin.hpp>
 
 #include <cmath>
@@ -69,37 +74,31 @@ class Epsd {
   }
 
   // Called from several threads at once on the same instance (abi.h):
-  // const, and every per-contact state lives in b.history.
-  void compute(domel_contact_batch_v1& b) const {
+  // const, and every per-contact state lives in b.history. The SDK hands
+  // compute() batches of one material pair (b.pair is set).
+  void compute(domel_contact_batch_v2& b) const {
+    using domel::sdk::Vec3;
     const uint32_t stride = b.history_stride;
+    const double mu_r = b.pair->has_rolling_friction != 0 ? b.pair->rolling_friction : mu_r_;
+    const bool wall = b.pair->is_wall != 0;
     for (uint32_t c = 0; c < b.n; ++c) {
       const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
 
       // omega_r: the rolling part of omega_i - omega_j (the part about n is twisting).
-      const double wn = b.wx[c] * nx + b.wy[c] * ny + b.wz[c] * nz;
-      const double wrx = b.wx[c] - wn * nx, wry = b.wy[c] - wn * ny, wrz = b.wz[c] - wn * nz;
+      const Vec3 wr = domel::sdk::rolling_velocity(b.wx[c], b.wy[c], b.wz[c], nx, ny, nz);
 
       // Spring, dashpot and cap of this contact.
       const double r = b.r_eff[c];
-      const double k_r = 2.25 * b.kn[c] * mu_r_ * mu_r_ * r * r;
-      const double c_r = eta_r_ * 2.0 * std::sqrt(rolling_inertia(b, c) * k_r);
-      const double f_n = b.fn[c] > 0.0 ? b.fn[c] : 0.0;
-      const double m_max = mu_r_ * r * f_n;
+      const double k_r = 2.25 * b.kn[c] * mu_r * mu_r * r * r;
+      const double c_r = eta_r_ * 2.0 * std::sqrt(rolling_inertia(b, c, wall) * k_r);
+      const double m_max = mu_r * r * domel::sdk::cap_force(b.fn[c]);
 
-      // M_k from the history, rotated into the current tangent plane.
+      // M_k from the history, carried into the current tangent plane (its length kept).
       double* h = b.history + static_cast<size_t>(c) * stride;
-      double mx = h[0], my = h[1], mz = h[2];
-      const double len_old = std::sqrt(mx * mx + my * my + mz * mz);
-      const double mn = mx * nx + my * ny + mz * nz;
-      mx -= mn * nx; my -= mn * ny; mz -= mn * nz;
-      const double len_new = std::sqrt(mx * mx + my * my + mz * mz);
-      if (len_new > 0.0) {
-        const double keep = len_old / len_new;
-        mx *= keep; my *= keep; mz *= keep;
-      }
+      const Vec3 mk = domel::sdk::tangent_keep_length(h[0], h[1], h[2], nx, ny, nz);
 
       // Incremental spring: M_k += k_r omega_r dt.
-      mx += k_r * wrx * b.dt; my += k_r * wry * b.dt; mz += k_r * wrz * b.dt;
+      double mx = mk.x + k_r * wr.x * b.dt, my = mk.y + k_r * wr.y * b.dt, mz = mk.z + k_r * wr.z * b.dt;
 
       // Plastic cap, or the dashpot while elastic.
       const double len = std::sqrt(mx * mx + my * my + mz * mz);
@@ -109,38 +108,28 @@ class Epsd {
         mx *= scale; my *= scale; mz *= scale;
         tx = mx; ty = my; tz = mz;  // fully mobilised: no dashpot (Ai et al.'s f = 0)
       } else {
-        tx = mx + c_r * wrx; ty = my + c_r * wry; tz = mz + c_r * wrz;
+        tx = mx + c_r * wr.x; ty = my + c_r * wr.y; tz = mz + c_r * wr.z;
       }
       h[0] = mx; h[1] = my; h[2] = mz;
 
       // The couple on i is -M, added to what earlier stages wrote; j gets +M from the host.
       b.tqx[c] -= tx; b.tqy[c] -= ty; b.tqz[c] -= tz;
 
-      // For the host's rotational time-step check (ABI 1.1).
+      // For the host's rotational time-step check.
       b.rolling_stiffness[c] = k_r;
       b.rolling_damping[c] = c_r;
     }
   }
 
  private:
-  // I_r = 1.4 (m_i R_i^2)(m_j R_j^2) / (m_i R_i^2 + m_j R_j^2)   (3-D, physics §2.2)
-  // The batch carries m* = m_i m_j/(m_i + m_j), R_i and R_j, not m_i and m_j.
-  // Assuming both spheres have the same density (true inside one domel
-  // subdomain, whose particles share one material), m = c R^3 and
-  //   m* = c R_i^3 R_j^3/(R_i^3 + R_j^3)  =>  c = m* (R_i^3 + R_j^3)/(R_i^3 R_j^3),
-  //   I_r = 1.4 c R_i^5 R_j^5/(R_i^5 + R_j^5)
-  //       = 1.4 m* (R_i^3 + R_j^3) R_i^2 R_j^2 / (R_i^5 + R_j^5).
-  // Equal spheres: 1.4 m* R^2 = 0.7 m R^2, as the exact formula.
-  // Wall: I_r = 1.4 m_i R_i^2 with m_i = m*.
-  // The host's set-up probe of a particle pair (docs/sdk-guide.md) passes
-  // R_j = 0 for two equal spheres with R* = R/2: I_r = 1.4 m* (2 R*)^2.
-  static double rolling_inertia(const domel_contact_batch_v1& b, uint32_t c) {
-    const double ri = b.radius_i[c], rj = b.radius_j[c];
-    if (b.pair->is_wall != 0) return 1.4 * b.m_eff[c] * ri * ri;
-    if (!(rj > 0.0)) return 1.4 * b.m_eff[c] * 4.0 * b.r_eff[c] * b.r_eff[c];
-    const double ri2 = ri * ri, rj2 = rj * rj;
-    const double ri3 = ri2 * ri, rj3 = rj2 * rj;
-    return 1.4 * b.m_eff[c] * (ri3 + rj3) * ri2 * rj2 / (ri3 * ri2 + rj3 * rj2);
+  // I_r = 1.4 (m_i R_i^2)(m_j R_j^2) / (m_i R_i^2 + m_j R_j^2)   (3-D, physics §2.2),
+  // from the batch's masses and radii; a wall (mass_j = 0): I_r = 1.4 m_i R_i^2.
+  // Equal spheres: 0.7 m R^2.
+  static double rolling_inertia(const domel_contact_batch_v2& b, uint32_t c, bool wall) {
+    const double ii = b.mass_i[c] * b.radius_i[c] * b.radius_i[c];
+    if (wall || !(b.mass_j[c] > 0.0)) return 1.4 * ii;
+    const double ij = b.mass_j[c] * b.radius_j[c] * b.radius_j[c];
+    return 1.4 * ii * ij / (ii + ij);
   }
 
   double mu_r_;

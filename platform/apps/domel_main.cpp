@@ -246,7 +246,7 @@ int cmd_plugins(int argc, char** argv) {
     for (const auto& m : registry.models()) {
       const auto& lib = registry.libraries()[m.library];
       out.push_back({{"name", m.name}, {"kind", dp::kind_name(m.desc.kind)}, {"version", m.version},
-                     {"summary", m.summary}, {"history_slots", m.desc.history_slots},
+                     {"summary", m.summary}, {"history_slots", m.contact.history_slots},
                      {"library", lib.name}, {"library_version", lib.version}, {"path", lib.path.string()},
                      {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)},
                      {"parameters", m.schema}});

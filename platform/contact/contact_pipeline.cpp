@@ -18,18 +18,20 @@ ContactPipeline::ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlo
 ContactPipeline::Workspace::Workspace(uint32_t history_stride) {
   const std::size_t n = kBatchSize;
   for (auto* v : {&buf.overlap, &buf.nx, &buf.ny, &buf.nz, &buf.r_eff, &buf.m_eff, &buf.radius_i, &buf.radius_j,
-                  &buf.vn, &buf.vtx, &buf.vty, &buf.vtz, &buf.wx, &buf.wy, &buf.wz, &buf.fn_elastic, &buf.kn,
+                  &buf.mass_i, &buf.mass_j, &buf.vn, &buf.vtx, &buf.vty, &buf.vtz, &buf.wx, &buf.wy, &buf.wz, &buf.fn_elastic, &buf.kn,
                   &buf.kn_tangent, &buf.contact_radius, &buf.fn_damping, &buf.eta_n, &buf.fn, &buf.ftx, &buf.fty,
                   &buf.ftz, &buf.tqx, &buf.tqy, &buf.tqz, &buf.rolling_stiffness, &buf.rolling_damping})
     v->assign(n, 0.0);
   buf.history.assign(n * std::max<uint32_t>(history_stride, 1), 0.0);
+  buf.pair_of.assign(n, nullptr);
 
   auto& b = batch;
-  b.struct_size = sizeof(domel_contact_batch_v1);
+  b.struct_size = sizeof(domel_contact_batch_v2);
   b.overlap = buf.overlap.data();
   b.nx = buf.nx.data(); b.ny = buf.ny.data(); b.nz = buf.nz.data();
   b.r_eff = buf.r_eff.data(); b.m_eff = buf.m_eff.data();
   b.radius_i = buf.radius_i.data(); b.radius_j = buf.radius_j.data();
+  b.mass_i = buf.mass_i.data(); b.mass_j = buf.mass_j.data();
   b.vn = buf.vn.data();
   b.vtx = buf.vtx.data(); b.vty = buf.vty.data(); b.vtz = buf.vtz.data();
   b.wx = buf.wx.data(); b.wy = buf.wy.data(); b.wz = buf.wz.data();
@@ -43,12 +45,23 @@ ContactPipeline::Workspace::Workspace(uint32_t history_stride) {
   b.rolling_damping = buf.rolling_damping.data();
 }
 
-void ContactPipeline::evaluate(Workspace& ws, const domel_pair_v1& pair, double dt, uint32_t n) const {
+void ContactPipeline::evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const {
+  ws.batch.pair = &pair;  // one pair for the batch: read once per batch by the kernels (abi.h)
+  ws.batch.pair_of = nullptr;
+  run_stages(ws, dt, n);
+}
+
+void ContactPipeline::evaluate(Workspace& ws, double dt, uint32_t n) const {
+  ws.batch.pair = nullptr;
+  ws.batch.pair_of = ws.buf.pair_of.data();
+  run_stages(ws, dt, n);
+}
+
+void ContactPipeline::run_stages(Workspace& ws, double dt, uint32_t n) const {
   auto& b = ws.batch;
   auto& buf = ws.buf;
   b.n = n;
   b.dt = dt;
-  b.pair = &pair;
   auto run = [&](Slot s) {
     const auto& inst = slots_[static_cast<int>(s)];
     if (!inst) return;

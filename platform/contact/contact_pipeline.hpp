@@ -6,8 +6,12 @@
 // the per-contact history; the pipeline lays the slices out in one stride.
 //
 // Callers fill the input arrays of a Workspace for up to kBatchSize contacts
-// (and their history rows), call evaluate(workspace, pair, dt, n), then read
-// fn and the tangential force and torque outputs. The slot instances are
+// (and their history rows, masses included: mass_j = 0 for a wall), call
+// evaluate(workspace, pair, dt, n) when every contact shares one material
+// pair (today always: the batch then carries the pair once, abi.h), or
+// evaluate(workspace, dt, n) after filling buf.pair_of per contact, grouped
+// by pair, for a batch of several pairs; then read fn and the tangential
+// force and torque outputs. The slot instances are
 // shared; each thread uses its own Workspace (kernels may run concurrently
 // on one instance, see abi.h).
 #pragma once
@@ -39,11 +43,13 @@ class ContactPipeline {
 
   /// Buffers of one batch (structure of arrays, capacity kBatchSize).
   struct Buffers {
-    std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, vn, vtx, vty, vtz, wx, wy, wz;
+    std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, mass_i, mass_j, vn, vtx, vty, vtz, wx,
+        wy, wz;
     std::vector<double> fn_elastic, kn, kn_tangent, contact_radius, fn_damping, eta_n, fn;
     std::vector<double> ftx, fty, ftz, tqx, tqy, tqz;
     std::vector<double> rolling_stiffness, rolling_damping;
     std::vector<double> history;  ///< kBatchSize * history_stride
+    std::vector<const domel_pair_v2*> pair_of;  ///< per contact, for a batch of several pairs
   };
   /// One thread's batch buffers and the ABI view of them.
   class Workspace {
@@ -52,22 +58,25 @@ class ContactPipeline {
     Workspace(const Workspace&) = delete;
     Workspace& operator=(const Workspace&) = delete;
     Buffers buf;
-    domel_contact_batch_v1 batch{};
+    domel_contact_batch_v2 batch{};
   };
   std::unique_ptr<Workspace> make_workspace() const { return std::make_unique<Workspace>(history_stride_); }
 
-  /// Evaluate all stages on the first n contacts of a workspace.
-  void evaluate(Workspace& ws, const domel_pair_v1& pair, double dt, uint32_t n) const;
+  /// Evaluate all stages on the first n contacts of a workspace, all of one material pair.
+  void evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const;
+  /// The same for a batch of several pairs: contact c uses *ws.buf.pair_of[c].
+  void evaluate(Workspace& ws, double dt, uint32_t n) const;
 
   /// The pipeline's own workspace, for single-threaded callers.
   Buffers& buffers() { return main_->buf; }
-  void evaluate(const domel_pair_v1& pair, double dt, uint32_t n) { evaluate(*main_, pair, dt, n); }
+  void evaluate(const domel_pair_v2& pair, double dt, uint32_t n) { evaluate(*main_, pair, dt, n); }
 
  private:
   std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots_;
   std::array<uint32_t, kSlotCount> offset_{};
   uint32_t history_stride_ = 0;
   std::unique_ptr<Workspace> main_;
+  void run_stages(Workspace& ws, double dt, uint32_t n) const;
 };
 
 }  // namespace domel::platform

@@ -40,20 +40,22 @@ inline void copy_row(const double* __restrict src, double* __restrict dst, uint3
 
 /// The batch arrays the gather fills.
 struct Slots {
-  double *overlap, *nx, *ny, *nz, *radius_i, *radius_j, *r_eff, *m_eff, *vn, *vtx, *vty, *vtz, *wx, *wy, *wz;
+  double *overlap, *nx, *ny, *nz, *radius_i, *radius_j, *r_eff, *m_eff, *mass_i, *mass_j, *vn, *vtx, *vty, *vtz,
+      *wx, *wy, *wz;
   explicit Slots(ContactPipeline::Buffers& b)
       : overlap(b.overlap.data()), nx(b.nx.data()), ny(b.ny.data()), nz(b.nz.data()),
         radius_i(b.radius_i.data()), radius_j(b.radius_j.data()), r_eff(b.r_eff.data()), m_eff(b.m_eff.data()),
-        vn(b.vn.data()), vtx(b.vtx.data()), vty(b.vty.data()), vtz(b.vtz.data()), wx(b.wx.data()),
-        wy(b.wy.data()), wz(b.wz.data()) {}
+        mass_i(b.mass_i.data()), mass_j(b.mass_j.data()), vn(b.vn.data()), vtx(b.vtx.data()), vty(b.vty.data()),
+        vtz(b.vtz.data()), wx(b.wx.data()), wy(b.wy.data()), wz(b.wz.data()) {}
 };
 
 /// The gather, shared by pairs and walls: slot q of the batch from the
 /// contact's geometry and the relative velocity (rx, ry, rz) of its contact
 /// points, split into the normal approach speed and the tangential part.
+/// A wall is partner j with rj = 0 and mj = 0.
 inline void fill_slot(const Slots& b, uint32_t q, double delta, double nx, double ny, double nz, double ri,
-                      double rj, double r_eff, double m_eff, double rx, double ry, double rz, double wx, double wy,
-                      double wz) {
+                      double rj, double r_eff, double mi, double mj, double m_eff, double rx, double ry, double rz,
+                      double wx, double wy, double wz) {
   const double vdotn = rx * nx + ry * ny + rz * nz;
   b.overlap[q] = delta;
   b.nx[q] = nx; b.ny[q] = ny; b.nz[q] = nz;
@@ -61,6 +63,8 @@ inline void fill_slot(const Slots& b, uint32_t q, double delta, double nx, doubl
   b.radius_j[q] = rj;
   b.r_eff[q] = r_eff;
   b.m_eff[q] = m_eff;
+  b.mass_i[q] = mi;
+  b.mass_j[q] = mj;
   b.vn[q] = -vdotn;
   b.vtx[q] = rx - vdotn * nx; b.vty[q] = ry - vdotn * ny; b.vtz[q] = rz - vdotn * nz;
   b.wx[q] = wx; b.wy[q] = wy; b.wz[q] = wz;
@@ -174,7 +178,8 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       point_velocity(pvx[i], pvy[i], pvz[i], wix, wiy, wiz, -ci, nx, ny, nz, vix, viy, viz);
       point_velocity(pvx[j], pvy[j], pvz[j], wjx, wjy, wjz, cj, nx, ny, nz, vjx, vjy, vjz);
       // one division for R* and the overlap ratio
-      fill_slot(slots, q, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, pm[i] * pm[j] / (pm[i] + pm[j]),
+      const double mi = pm[i], mj = pm[j];
+      fill_slot(slots, q, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, mi, mj, mi * mj / (mi + mj),
                 vix - vjx, viy - vjy, viz - vjz, wix - wjx, wiy - wjy, wiz - wjz);
       copy_row(list_history + static_cast<std::size_t>(le) * stride, b_hist + static_cast<std::size_t>(q) * stride,
                stride);
@@ -292,8 +297,8 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         wall.surface_velocity(sw.wall_time, s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
         rx -= ux; ry -= uy; rz -= uz;
       }
-      fill_slot(slots, c, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], rx, ry, rz, s.wx[i], s.wy[i],
-                s.wz[i]);
+      fill_slot(slots, c, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], 0.0, s.mass[i], rx, ry, rz,
+                s.wx[i], s.wy[i], s.wz[i]);
       copy_row(list.history.data() + e * stride, buf.history.data() + c * stride, stride);
       list.touching[e] = 1;
       ts.entry[c] = static_cast<uint32_t>(e);

@@ -63,7 +63,7 @@ struct PairSweep {
   const ParticleStore* store;
   NeighborList* list;
   const ContactPipeline* pipeline;
-  const domel_pair_v1* pair;
+  const domel_pair_v2* pair;
   double dt;
   bool record;  ///< append each contact's force to ContactScratch::records
 };
@@ -83,7 +83,7 @@ struct WallSweep {
   ParticleStore* store;
   std::vector<WallNeighbors>* lists;
   const std::vector<WallPrimitive>* walls;   ///< placed at wall_time
-  const std::vector<domel_pair_v1>* pairs;   ///< per wall
+  const std::vector<domel_pair_v2>* pairs;   ///< per wall
   const ContactPipeline* pipeline;
   double dt;
   double forces_time;  ///< the force evaluation's time (which walls are active)

@@ -28,7 +28,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
   // spheres: I/2; sphere on a wall: I), for the rolling spring's own limit
   // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
   // (docs/physics.md §3.6).
-  auto collide = [&](const domel_pair_v1& pair, double r_i, double r_j, double m_eff, double i_red,
+  auto collide = [&](const domel_pair_v2& pair, double r_i, double r_j, double m_eff, double i_red,
                      double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
     const double r_eff = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
@@ -41,6 +41,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
       auto force = [&](double d, double vel) {
         buf.overlap[0] = std::max(d, 1e-300);
         buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_i; buf.radius_j[0] = r_j;
+        buf.mass_i[0] = r_j > 0 ? 2.0 * m_eff : m_eff; buf.mass_j[0] = r_j > 0 ? 2.0 * m_eff : 0.0;  // equal spheres or a wall
         buf.nx[0] = 0; buf.ny[0] = 0; buf.nz[0] = 1; buf.vn[0] = vel;
         buf.vtx[0] = buf.vty[0] = buf.vtz[0] = 0; buf.wx[0] = buf.wy[0] = buf.wz[0] = 0;
         std::fill(buf.history.begin(), buf.history.end(), 0.0);

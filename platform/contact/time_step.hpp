@@ -31,8 +31,8 @@ struct TimeStepReport {
 struct TimeStepInputs {
   ContactPipeline* pipeline;
   const Material* material;
-  const domel_pair_v1* self_pair;
-  const std::vector<domel_pair_v1>* wall_pairs;  ///< per wall
+  const domel_pair_v2* self_pair;
+  const std::vector<domel_pair_v2>* wall_pairs;  ///< per wall
   const std::vector<WallPrimitive>* walls;       ///< names, for the report
 };
 

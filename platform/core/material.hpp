@@ -24,10 +24,10 @@ struct PairCoefficients {
 };
 
 /// 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j ; 1/G* = 2(2-nu_i)(1+nu_i)/E_i + (same for j).
-inline domel_pair_v1 make_pair(const Material& a, const Material& b, const PairCoefficients& c,
+inline domel_pair_v2 make_pair(const Material& a, const Material& b, const PairCoefficients& c,
                                bool is_wall, double coarse_grain) {
-  domel_pair_v1 p{};
-  p.struct_size = sizeof(domel_pair_v1);
+  domel_pair_v2 p{};
+  p.struct_size = sizeof(domel_pair_v2);
   p.is_wall = is_wall ? 1u : 0u;
   p.youngs_eff = 1.0 / ((1.0 - a.poisson_ratio * a.poisson_ratio) / a.youngs_modulus +
                         (1.0 - b.poisson_ratio * b.poisson_ratio) / b.youngs_modulus);
@@ -36,6 +36,8 @@ inline domel_pair_v1 make_pair(const Material& a, const Material& b, const PairC
   p.restitution = c.restitution;
   p.friction = c.friction;
   p.coarse_grain = coarse_grain;
+  // rolling_friction: not given (has_rolling_friction 0) until scenarios set
+  // it per material pair (the mixtures issue); the rolling model's own applies
   return p;
 }
 

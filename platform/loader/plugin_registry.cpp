@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <sstream>
 
 namespace domel::platform {
@@ -21,28 +22,24 @@ constexpr KindName kKindNames[] = {
     {DOMEL_KIND_NORMAL, "normal"},       {DOMEL_KIND_DAMPING, "damping"},
     {DOMEL_KIND_TANGENTIAL, "tangential"}, {DOMEL_KIND_ROLLING, "rolling"},
     {DOMEL_KIND_TWISTING, "twisting"},   {DOMEL_KIND_INSERTION, "insertion"},
-    {DOMEL_KIND_FLUID, "fluid"},         {DOMEL_KIND_CONTROLLER, "controller"}};
+    {DOMEL_KIND_FLUID_COUPLER, "fluid_coupler"}, {DOMEL_KIND_CONTROLLER, "controller"}};
 
-bool is_contact_kind(uint32_t k) {
-  return k == DOMEL_KIND_NORMAL || k == DOMEL_KIND_DAMPING || k == DOMEL_KIND_TANGENTIAL ||
-         k == DOMEL_KIND_ROLLING || k == DOMEL_KIND_TWISTING;
-}
+/// The leading members of an ABI 1 library description (domel_library_v1 of
+/// SDK 1.x, frozen here): enough to name the library and its version in the
+/// refusal. ABI 2 keeps the same leading members.
+struct LibraryHeadV1 {
+  uint32_t struct_size;
+  uint32_t abi_major;
+  uint32_t abi_minor;
+  const char* name;
+  const char* version;
+};
+
+const std::string kRuntimeAbi = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR);
 
 [[noreturn]] void refuse(const std::filesystem::path& file, const std::string& why) {
   throw PluginError("plugin '" + file.string() + "' refused: " + why);
 }
-
-void host_log(void*, int level, const char* message) {
-  const char* m = message ? message : "";
-  switch (level) {
-    case 0: spdlog::debug("[plugin] {}", m); break;
-    case 1: spdlog::info("[plugin] {}", m); break;
-    case 2: spdlog::warn("[plugin] {}", m); break;
-    default: spdlog::error("[plugin] {}", m); break;
-  }
-}
-
-const domel_host_v1 kHost = {sizeof(domel_host_v1), DOMEL_ABI_MINOR, nullptr, &host_log};
 
 }  // namespace
 
@@ -58,7 +55,10 @@ uint32_t kind_from_name(const std::string& name) {
   return 0;
 }
 
-const domel_host_v1* host_services() { return &kHost; }
+bool is_contact_kind(uint32_t k) {
+  return k == DOMEL_KIND_NORMAL || k == DOMEL_KIND_DAMPING || k == DOMEL_KIND_TANGENTIAL ||
+         k == DOMEL_KIND_ROLLING || k == DOMEL_KIND_TWISTING;
+}
 
 void PluginRegistry::load(const std::filesystem::path& path) {
   std::error_code ec;
@@ -76,38 +76,59 @@ void PluginRegistry::load(const std::filesystem::path& path) {
     refuse(file, std::string("cannot be loaded as a shared library: ") + e.what());
   }
   if (!handle.has(DOMEL_ENTRY_SYMBOL)) {
-    for (int major = 2; major <= 9; ++major) {
+    // ABI 1: refused, naming both versions (docs/sdk-guide.md, "Versions").
+    // The v1 entry is called only to read the library's name and version.
+    if (handle.has("domel_plugin_entry_v1")) {
+      const LibraryHeadV1* old = nullptr;
+      try {
+        old = handle.get<const LibraryHeadV1*()>("domel_plugin_entry_v1")();
+      } catch (const std::exception&) {
+      }
+      std::string built = "domel ABI 1";
+      if (old != nullptr && old->struct_size >= sizeof(LibraryHeadV1))
+        built = std::string("library '") + (old->name ? old->name : "") + "' " + (old->version ? old->version : "") +
+                " was built for domel ABI " + std::to_string(old->abi_major) + "." + std::to_string(old->abi_minor);
+      else
+        built = "it was built for domel ABI 1.x";
+      refuse(file, built + " (it exports 'domel_plugin_entry_v1'); this runtime speaks ABI " + kRuntimeAbi +
+                       ": rebuild it against domel SDK " + std::to_string(DOMEL_ABI_MAJOR) +
+                       " (docs/sdk-guide.md, \"Versions\")");
+    }
+    for (int major = DOMEL_ABI_MAJOR + 1; major <= 9; ++major) {
       const std::string other = "domel_plugin_entry_v" + std::to_string(major);
       if (handle.has(other))
-        refuse(file, "it exports '" + other + "', i.e. it was built against domel SDK ABI " +
-                         std::to_string(major) + ".x; this domel loads ABI " +
-                         std::to_string(DOMEL_ABI_MAJOR) + ".x plugins");
+        refuse(file, "it exports '" + other + "', i.e. it was built for domel ABI " + std::to_string(major) +
+                         ".x; this runtime speaks ABI " + kRuntimeAbi + ": use a domel that speaks ABI " +
+                         std::to_string(major) + ", or rebuild the plugin against domel SDK " +
+                         std::to_string(DOMEL_ABI_MAJOR));
     }
     refuse(file, std::string("not a domel plugin: it does not export '") + DOMEL_ENTRY_SYMBOL + "'");
   }
-  const domel_library_v1* lib = nullptr;
+  const domel_library_v2* lib = nullptr;
   try {
-    lib = handle.get<const domel_library_v1*()>(DOMEL_ENTRY_SYMBOL)();
+    lib = handle.get<const domel_library_v2*()>(DOMEL_ENTRY_SYMBOL)();
   } catch (const std::exception& e) {
     refuse(file, std::string("its entry function failed: ") + e.what());
   }
   if (lib == nullptr) refuse(file, "its entry function returned no library description");
-  if (lib->struct_size < offsetof(domel_library_v1, models) + sizeof(lib->models))
-    refuse(file, "its library description is truncated (struct_size " + std::to_string(lib->struct_size) + ")");
+  if (lib->struct_size < offsetof(domel_library_v2, models) + sizeof(lib->models))
+    refuse(file, "its library description is truncated (struct_size " + std::to_string(lib->struct_size) +
+                     ", expected at least " +
+                     std::to_string(offsetof(domel_library_v2, models) + sizeof(lib->models)) + ")");
 
   const std::string lib_name = lib->name ? lib->name : "";
   const std::string lib_version = lib->version ? lib->version : "";
   const std::string who = "library '" + lib_name + "' " + lib_version;
+  const std::string built = std::to_string(lib->abi_major) + "." + std::to_string(lib->abi_minor);
   if (lib->abi_major != DOMEL_ABI_MAJOR)
-    refuse(file, who + " was built against domel SDK ABI " + std::to_string(lib->abi_major) + "." +
-                     std::to_string(lib->abi_minor) + "; this domel needs ABI major " +
-                     std::to_string(DOMEL_ABI_MAJOR) + " (it speaks " + std::to_string(DOMEL_ABI_MAJOR) +
-                     "." + std::to_string(DOMEL_ABI_MINOR) + ")");
+    refuse(file, who + " was built for domel ABI " + built + "; this runtime speaks ABI " + kRuntimeAbi +
+                     (lib->abi_major > DOMEL_ABI_MAJOR
+                          ? ": use a domel that speaks ABI " + std::to_string(lib->abi_major) +
+                                ", or rebuild the plugin against domel SDK " + std::to_string(DOMEL_ABI_MAJOR)
+                          : ": rebuild it against domel SDK " + std::to_string(DOMEL_ABI_MAJOR)));
   if (lib->abi_minor > DOMEL_ABI_MINOR)
-    refuse(file, who + " was built against the newer domel SDK ABI " + std::to_string(lib->abi_major) + "." +
-                     std::to_string(lib->abi_minor) + "; this domel supports up to " +
-                     std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR) +
-                     ": upgrade domel or rebuild the plugin against this SDK");
+    refuse(file, who + " was built for the newer domel ABI " + built + "; this runtime supports up to " +
+                     kRuntimeAbi + ": upgrade domel or rebuild the plugin against this SDK");
   if (lib_name.empty()) refuse(file, "its library description has no name");
   // The same library reached through two folders (build tree and install
   // prefix, or a folder listed twice): keep the first, say so in the debug log.
@@ -123,15 +144,16 @@ void PluginRegistry::load(const std::filesystem::path& path) {
   // Check every model before registering any, so a refused library leaves no trace.
   std::vector<RegisteredModel> incoming;
   for (uint32_t k = 0; k < lib->model_count; ++k) {
-    const domel_model_v1* d = lib->models[k];
+    const domel_model_v2* d = lib->models[k];
     const std::string slot = "model #" + std::to_string(k);
     if (d == nullptr) refuse(file, who + ": " + slot + " is null");
-    if (d->struct_size < offsetof(domel_model_v1, insert))
-      refuse(file, who + ": " + slot + " descriptor is truncated (struct_size " +
-                       std::to_string(d->struct_size) + ")");
+    if (d->struct_size < offsetof(domel_model_v2, family) + sizeof(d->family))
+      refuse(file, who + ": " + slot + " descriptor is truncated (struct_size " + std::to_string(d->struct_size) +
+                       ", expected at least " + std::to_string(offsetof(domel_model_v2, family) + sizeof(d->family)) +
+                       ")");
     RegisteredModel m;
-    std::memcpy(&m.desc, d, std::min<std::size_t>(d->struct_size, sizeof(domel_model_v1)));
-    m.desc.struct_size = sizeof(domel_model_v1);
+    std::memcpy(&m.desc, d, std::min<std::size_t>(d->struct_size, sizeof(domel_model_v2)));
+    m.desc.struct_size = sizeof(domel_model_v2);
     if (m.desc.name == nullptr || *m.desc.name == '\0')
       refuse(file, who + ": " + slot + " lacks required member 'name'");
     m.name = m.desc.name;
@@ -145,11 +167,42 @@ void PluginRegistry::load(const std::filesystem::path& path) {
     require(m.desc.params_schema_json, "params_schema_json");
     require(reinterpret_cast<const void*>(m.desc.create), "create");
     require(reinterpret_cast<const void*>(m.desc.destroy), "destroy");
-    if (is_contact_kind(m.desc.kind)) require(reinterpret_cast<const void*>(m.desc.contact), "contact");
-    if (m.desc.kind == DOMEL_KIND_INSERTION) require(reinterpret_cast<const void*>(m.desc.insert), "insert");
-    if (m.desc.kind == DOMEL_KIND_FLUID || m.desc.kind == DOMEL_KIND_CONTROLLER)
-      refuse(file, who + ": " + what + ": this domel does not run " + kind_name(m.desc.kind) +
-                       " models yet (this ABI has no callbacks for them)");
+    require(m.desc.family, "family");
+    // The family table: copied zero-filled up to its struct_size; a required
+    // callback beyond that size or null is missing, and named.
+    auto table = [&](auto& out, const char* table_name, const char* callback, std::size_t callback_end) {
+      const uint32_t size = *static_cast<const uint32_t*>(m.desc.family);
+      if (size < sizeof(uint32_t))
+        refuse(file, who + ": " + what + ": its " + table_name + " has struct_size " + std::to_string(size));
+      std::memcpy(&out, m.desc.family, std::min<std::size_t>(size, sizeof(out)));
+      out.struct_size = sizeof(out);
+      if (size < callback_end)
+        refuse(file, who + ": " + what + " lacks required callback '" + callback + "': its " + table_name +
+                         " is " + std::to_string(size) + " bytes, the callback ends at byte " +
+                         std::to_string(callback_end));
+    };
+    if (is_contact_kind(m.desc.kind)) {
+      table(m.contact, "domel_contact_family_v2", "contact",
+            offsetof(domel_contact_family_v2, contact) + sizeof(m.contact.contact));
+      if (m.contact.contact == nullptr)
+        refuse(file, who + ": " + what + " lacks required callback 'contact' (domel_contact_family_v2)");
+    } else if (m.desc.kind == DOMEL_KIND_INSERTION) {
+      table(m.insertion, "domel_insertion_family_v2", "insert",
+            offsetof(domel_insertion_family_v2, insert) + sizeof(m.insertion.insert));
+      if (m.insertion.insert == nullptr)
+        refuse(file, who + ": " + what + " lacks required callback 'insert' (domel_insertion_family_v2)");
+    } else if (m.desc.kind == DOMEL_KIND_CONTROLLER) {
+      table(m.controller, "domel_controller_family_v1", "control",
+            offsetof(domel_controller_family_v1, control) + sizeof(m.controller.control));
+      if (m.controller.control == nullptr)
+        refuse(file, who + ": " + what + " lacks required callback 'control' (domel_controller_family_v1)");
+    } else if (m.desc.kind == DOMEL_KIND_FLUID_COUPLER) {
+      table(m.fluid_coupler, "domel_fluid_coupler_family_v1", "exchange",
+            offsetof(domel_fluid_coupler_family_v1, exchange) + sizeof(m.fluid_coupler.exchange));
+      if (m.fluid_coupler.exchange == nullptr)
+        refuse(file, who + ": " + what + " lacks required callback 'exchange' (domel_fluid_coupler_family_v1)");
+    }
+    m.library_name = lib_name;
     m.version = m.desc.version;
     m.summary = m.desc.summary ? m.desc.summary : "";
     try {
@@ -234,16 +287,47 @@ std::vector<std::filesystem::path> default_plugin_directories() {
   return unique;
 }
 
+/// The instance's side of its domel_host_v2: the context prefix and the
+/// last error the plugin reported.
+struct ModelInstance::HostContext {
+  std::string prefix;
+  mutable std::mutex mutex;
+  std::string last_error;
+  domel_host_v2 host{};
+
+  static void log(void* context, int level, const char* message) {
+    const auto* c = static_cast<const HostContext*>(context);
+    const char* m = message ? message : "";
+    switch (level) {
+      case 0: spdlog::debug("[{}] {}", c->prefix, m); break;
+      case 1: spdlog::info("[{}] {}", c->prefix, m); break;
+      case 2: spdlog::warn("[{}] {}", c->prefix, m); break;
+      default: spdlog::error("[{}] {}", c->prefix, m); break;
+    }
+  }
+  static void error(void* context, domel_status code, const char* message) {
+    auto* c = static_cast<HostContext*>(context);
+    const char* m = message ? message : "";
+    spdlog::error("[{}] error {}: {}", c->prefix, static_cast<int>(code), m);
+    std::lock_guard<std::mutex> lock(c->mutex);
+    c->last_error = m;
+  }
+};
+
 ModelInstance::ModelInstance(const RegisteredModel& model, const nlohmann::json& params,
                              const std::string& where)
-    : model_(&model) {
+    : model_(&model), host_(std::make_unique<HostContext>()) {
+  host_->prefix = std::string(kind_name(model.desc.kind)) + " model '" + model.name + "' (library '" +
+                  model.library_name + "')" + (where.empty() ? std::string() : " at " + where);
+  host_->host = {sizeof(domel_host_v2), DOMEL_ABI_MINOR, host_.get(), &HostContext::log, &HostContext::error};
   char err[1024] = {0};
   const std::string text = params.dump();
-  const domel_status st = model.desc.create(text.c_str(), host_services(), &handle_, err, sizeof err);
+  const domel_status st = model.desc.create(text.c_str(), &host_->host, &handle_, err, sizeof err);
   if (st != DOMEL_OK || handle_ == nullptr) {
     handle_ = nullptr;
+    const std::string reported = last_error();
     throw PluginError((where.empty() ? std::string() : where + ": ") + kind_name(model.desc.kind) + " model '" + model.name +
-                      "' refused its parameters: " + (err[0] ? err : "no message"));
+                      "' refused its parameters: " + (err[0] ? err : reported.empty() ? "no message" : reported.c_str()));
   }
 }
 
@@ -251,12 +335,36 @@ ModelInstance::~ModelInstance() {
   if (handle_) model_->desc.destroy(handle_);
 }
 
-void ModelInstance::contact(domel_contact_batch_v1& batch) const {
+const std::string& ModelInstance::context() const { return host_->prefix; }
+
+std::string ModelInstance::last_error() const {
+  std::lock_guard<std::mutex> lock(host_->mutex);
+  return host_->last_error;
+}
+
+void ModelInstance::fail(const char* what, const char* err) const {
+  const std::string reported = err[0] ? std::string() : last_error();
+  throw PluginError(host_->prefix + ": " + what + " failed: " +
+                    (err[0] ? std::string(err) : reported.empty() ? std::string("no message") : reported));
+}
+
+void ModelInstance::contact(domel_contact_batch_v2& batch) const {
   char err[1024] = {0};
-  const domel_status st = model_->desc.contact(handle_, &batch, err, sizeof err);
-  if (st != DOMEL_OK)
-    throw PluginError(std::string(kind_name(model_->desc.kind)) + " model '" + model_->name +
-                      "' failed: " + (err[0] ? err : "no message"));
+  if (model_->contact.contact(handle_, &batch, err, sizeof err) != DOMEL_OK) fail("contact kernel", err);
+}
+
+void ModelInstance::control(domel_control_step_v1& step) const {
+  if (model_->controller.control == nullptr)
+    throw PluginError(host_->prefix + ": is not a controller (it has no 'control' callback)");
+  char err[1024] = {0};
+  if (model_->controller.control(handle_, &step, err, sizeof err) != DOMEL_OK) fail("control", err);
+}
+
+void ModelInstance::exchange(domel_fluid_exchange_v1& ex) const {
+  if (model_->fluid_coupler.exchange == nullptr)
+    throw PluginError(host_->prefix + ": is not a fluid coupler (it has no 'exchange' callback)");
+  char err[1024] = {0};
+  if (model_->fluid_coupler.exchange(handle_, &ex, err, sizeof err) != DOMEL_OK) fail("exchange", err);
 }
 
 void ModelInstance::insert(const domel_insert_request_v1& request, std::vector<double>& x,
@@ -266,16 +374,15 @@ void ModelInstance::insert(const domel_insert_request_v1& request, std::vector<d
     x.resize(capacity); y.resize(capacity); z.resize(capacity); r.resize(capacity);
     domel_insert_output_v1 out{sizeof(domel_insert_output_v1), capacity, attempt ? capacity : 0, x.data(), y.data(), z.data(), r.data()};
     char err[1024] = {0};
-    const domel_status st = model_->desc.insert(handle_, &request, &out, err, sizeof err);
+    const domel_status st = model_->insertion.insert(handle_, &request, &out, err, sizeof err);
     if (st == DOMEL_OK) {
       x.resize(out.count); y.resize(out.count); z.resize(out.count); r.resize(out.count);
       return;
     }
-    if (st != DOMEL_ERR_CAPACITY)
-      throw PluginError("insertion model '" + model_->name + "' failed: " + (err[0] ? err : "no message"));
+    if (st != DOMEL_ERR_CAPACITY) fail("insertion", err);
     capacity = out.count;
   }
-  throw PluginError("insertion model '" + model_->name + "' kept asking for a larger buffer");
+  throw PluginError(host_->prefix + ": kept asking for a larger buffer");
 }
 
 }  // namespace domel::platform

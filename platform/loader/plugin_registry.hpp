@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Plugin loading and the model registry. Libraries are opened at run time
-// with Boost.DLL; each must export domel_plugin_entry_v1 returning a
-// domel_library_v1. Every refusal throws PluginError naming the file and the
-// reason: unloadable file, missing entry symbol (or an entry of another ABI
-// major), ABI major mismatch, newer ABI minor, a library that registers
-// nothing, a model lacking a required callback, an unknown kind, an invalid
-// parameter schema, or a (kind, name) already provided by another library.
+// with Boost.DLL; each must export domel_plugin_entry_v2 returning a
+// domel_library_v2. Every refusal throws PluginError naming the file and the
+// reason: unloadable file, missing entry symbol, an ABI 1 plugin or one of a
+// future major (both versions named), newer ABI minor, a library that
+// registers nothing, a model lacking a required member or family callback
+// (named), an unknown kind, an invalid parameter schema, or a (kind, name)
+// already provided by another library.
 // Libraries stay loaded for the registry's lifetime, so model instances
 // never outlive their code.
 #pragma once
@@ -37,10 +38,16 @@ struct LibraryInfo {
   uint32_t abi_minor = 0;
 };
 
-/// A model as registered: a zero-filled copy of the plugin's descriptor
-/// (so fields appended in later ABI minors read as null/0) plus its origin.
+/// A model as registered: zero-filled copies of the plugin's descriptor and
+/// of its family table (so fields appended in later ABI minors read as
+/// null/0) plus its origin. Only the table of the model's family is filled.
 struct RegisteredModel {
-  domel_model_v1 desc{};
+  domel_model_v2 desc{};
+  domel_contact_family_v2 contact{};
+  domel_insertion_family_v2 insertion{};
+  domel_controller_family_v1 controller{};
+  domel_fluid_coupler_family_v1 fluid_coupler{};
+  std::string library_name;
   std::string name;
   std::string version;
   std::string summary;
@@ -82,7 +89,12 @@ class PluginRegistry {
 /// scans the tree it was built in.
 std::vector<std::filesystem::path> default_plugin_directories();
 
-/// A live model instance (RAII over create/destroy).
+/// True for the five contact-stage kinds (the contact family).
+bool is_contact_kind(uint32_t kind);
+
+/// A live model instance (RAII over create/destroy) with its own host
+/// services (domel_host_v2): the plugin's log lines and reported errors are
+/// prefixed with the model's kind, name, library and `where`.
 class ModelInstance {
  public:
   /// Calls the plugin's create; a refusal becomes PluginError with the
@@ -94,20 +106,29 @@ class ModelInstance {
 
   const RegisteredModel& model() const { return *model_; }
   void* handle() const { return handle_; }
-  uint32_t history_slots() const { return model_->desc.history_slots; }
+  uint32_t history_slots() const { return model_->contact.history_slots; }
+  /// "rolling model 'epsd' (library 'third_party_rolling') at <where>": the prefix of its messages.
+  const std::string& context() const;
+  /// The last error the plugin reported through the host's error service ("" if none).
+  std::string last_error() const;
 
   /// Run the contact kernel on a batch; a failure status throws PluginError.
-  void contact(domel_contact_batch_v1& batch) const;
+  void contact(domel_contact_batch_v2& batch) const;
   /// Run an insertion (with one capacity retry).
   void insert(const domel_insert_request_v1& request, std::vector<double>& x, std::vector<double>& y,
               std::vector<double>& z, std::vector<double>& r) const;
+  /// Run a controller on one control interval.
+  void control(domel_control_step_v1& step) const;
+  /// Run a fluid coupler's exchange of one coupling interval.
+  void exchange(domel_fluid_exchange_v1& exchange) const;
+
+  struct HostContext;  ///< the instance's side of domel_host_v2 (plugin_registry.cpp)
 
  private:
+  [[noreturn]] void fail(const char* what, const char* err) const;
   const RegisteredModel* model_;
+  std::unique_ptr<HostContext> host_;
   void* handle_ = nullptr;
 };
-
-/// The host services handed to plugins (logging through spdlog).
-const domel_host_v1* host_services();
 
 }  // namespace domel::platform

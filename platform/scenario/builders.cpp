@@ -101,7 +101,8 @@ std::unique_ptr<ContactPipeline> build_contact_pipeline(Build& b, const json& sd
       continue;
     }
     try {
-      slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]), "");
+      slots[s] = std::make_unique<ModelInstance>(*m, plugin_params(block, kSlotKinds[s]),
+                                                 "subdomain '" + sd["name"].get<std::string>() + "'");
     } catch (const PluginError& e) {
       b.ck.add(where, e.what());
       ok = false;
@@ -153,11 +154,12 @@ struct Inserter {
 };
 
 /// Throws PluginError when the plugin refuses its parameters. `derived_seed`
-/// is used when the block gives no seed.
-Inserter make_inserter(Build& b, const json& block, std::uint64_t derived_seed) {
+/// is used when the block gives no seed; the instance's messages name `subdomain`.
+Inserter make_inserter(Build& b, const json& block, const std::string& subdomain, std::uint64_t derived_seed) {
   Inserter ins;
   ins.registered = b.registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
-  ins.model = std::make_shared<ModelInstance>(*ins.registered, plugin_params(block, DOMEL_KIND_INSERTION), "");
+  ins.model = std::make_shared<ModelInstance>(*ins.registered, plugin_params(block, DOMEL_KIND_INSERTION),
+                                              "subdomain '" + subdomain + "'");
   ins.region = make_region(block["region"]);
   for (int a = 0; a < 3; ++a) ins.velocity[a] = block["velocity"][a].get<double>();
   ins.fixed = block["fixed"].get<bool>();
@@ -183,7 +185,7 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
     const json& block = sd["insert"][q];
     const std::string where = idx(base + "/insert", q);
     try {
-      const Inserter ins = make_inserter(b, block, b.sim.seed * 1000003ull + hash + q);
+      const Inserter ins = make_inserter(b, block, sub.name(), b.sim.seed * 1000003ull + hash + q);
       ParticleStore& st = sub.store();
       const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st);
       st.reserve(st.size() + c.size());
@@ -212,7 +214,7 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
     const json& pb = sd["pour"][q];
     const std::string where = idx(base + "/pour", q);
     try {
-      const Inserter ins = make_inserter(b, pb["insert"], b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
+      const Inserter ins = make_inserter(b, pb["insert"], sub.name(), b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
       Pour p;
       p.where = where;
       p.subdomain = b.sim.subdomains.size();

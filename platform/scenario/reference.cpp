@@ -197,7 +197,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       const auto& lib = registry.libraries()[m.library];
       os << "### `" << m.name << "`\n\n" << m.summary << "\n\n";
       os << "Version " << m.version << ", library `" << lib.name << "` " << lib.version
-         << ", per-contact history: " << m.desc.history_slots << " value(s).\n\n";
+         << ", per-contact history: " << m.contact.history_slots << " value(s).\n\n";
       if (m.schema.contains("description")) os << m.schema["description"].get<std::string>() << "\n\n";
       table(os, m.schema, root);
     }

@@ -172,8 +172,8 @@ class Subdomain {
   const std::vector<WallPrimitive>* walls_ = nullptr;  ///< reference state (time 0) of the walls
   std::vector<WallPrimitive> walls_now_;  ///< this subdomain's walls placed at wall_time_
   double wall_time_ = 0;                  ///< time of the walls' placement and surface velocities
-  std::vector<domel_pair_v1> wall_pairs_;
-  domel_pair_v1 self_pair_{};
+  std::vector<domel_pair_v2> wall_pairs_;
+  domel_pair_v2 self_pair_{};
   Material own_material_;
   BodyForces body_forces_;
   StepHooks hooks_;

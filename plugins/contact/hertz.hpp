@@ -28,7 +28,7 @@ class Hertz {
 
   explicit Hertz(const sdk::Params&) {}
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     kernel(b.n, b.pair->youngs_eff, b.r_eff, b.overlap, b.contact_radius, b.kn, b.kn_tangent, b.fn_elastic);
   }
 

@@ -48,7 +48,7 @@ class LinearNormal {
       throw sdk::ParameterError("linear: give exactly one of 'stiffness' or 'contact_time'");
   }
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     const double alpha = b.pair->coarse_grain > 0.0 ? b.pair->coarse_grain : 1.0;
     double factor = 0.0;  // k = factor * m* when derived from the contact time
     if (contact_time_ > 0.0) {

@@ -41,7 +41,7 @@ class LinearTangential {
       : stiffness_ratio_(p.number_or("stiffness_ratio", 2.0 / 7.0)),
         damping_ratio_(p.number_or("damping_ratio", std::sqrt(stiffness_ratio_))) {}
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     tangential_spring_coulomb<Dashpot::kScaled>(b, stiffness_ratio_, damping_ratio_, b.kn, b.eta_n);
   }
 

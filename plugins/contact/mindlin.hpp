@@ -33,7 +33,7 @@ class Mindlin {
 
   explicit Mindlin(const sdk::Params& p) : damping_(p.boolean_or("damping", true)) {}
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     const double g_eff = b.pair->shear_eff;
     const double le = std::log(b.pair->restitution);
     const double c_damp =

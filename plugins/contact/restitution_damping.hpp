@@ -34,7 +34,7 @@ class RestitutionDamping {
 
   explicit RestitutionDamping(const sdk::Params&) {}
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     if (b.n == 0) return;
     const double e = b.pair->restitution;
     const double le = std::log(e);

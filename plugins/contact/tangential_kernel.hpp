@@ -75,7 +75,7 @@ inline double stick_pass(uint32_t n, uint32_t s, double mu, double dt, double K,
 // (tests/validation/collapse_test.cpp: median |omega| 3e-6 instead of 3e-9
 // rad/s at t = 1.5 s with S-D rolling, dt = 5e-6 s).
 template <Dashpot kMode>
-inline void tangential_spring_coulomb(domel_contact_batch_v1& b, double K, double D, const double* u,
+inline void tangential_spring_coulomb(domel_contact_batch_v2& b, double K, double D, const double* u,
                                       const double* v) {
   const double mu = b.pair->friction;
   const uint32_t s = b.history_stride;

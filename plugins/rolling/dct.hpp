@@ -10,13 +10,16 @@
 // |delta omega| ~ M dt / I every step. No history.
 #pragma once
 
-#include "rolling_common.hpp"
-
+#include <domel/sdk/kinematics.hpp>
 #include <domel/sdk/plugin.hpp>
 
 #include <cmath>
 
 namespace domel::plugins::rolling {
+
+using sdk::cap_force;
+using sdk::rolling_velocity;
+using sdk::Vec3;
 
 class Dct {
  public:
@@ -44,8 +47,10 @@ class Dct {
     mu_r_ = by_mu ? p.number("rolling_friction") : std::tan(p.number("critical_angle") * M_PI / 180.0);
   }
 
-  void compute(domel_contact_batch_v1& b) const {
-    kernel(b.n, mu_r_, b.r_eff, b.fn_elastic, b.nx, b.ny, b.nz, b.wx, b.wy, b.wz, b.tqx, b.tqy, b.tqz);
+  void compute(domel_contact_batch_v2& b) const {
+    // the pair's mu_r when the scenario sets one for this material pair (abi.h)
+    const double mu_r = b.pair->has_rolling_friction != 0 ? b.pair->rolling_friction : mu_r_;
+    kernel(b.n, mu_r, b.r_eff, b.fn_elastic, b.nx, b.ny, b.nz, b.wx, b.wy, b.wz, b.tqx, b.tqy, b.tqz);
   }
 
  private:

@@ -24,13 +24,17 @@
 // is preserved under coarse-graining (§3.7, "implementation recommendation").
 #pragma once
 
-#include "rolling_common.hpp"
-
+#include <domel/sdk/kinematics.hpp>
 #include <domel/sdk/plugin.hpp>
 
 #include <cmath>
 
 namespace domel::plugins::rolling {
+
+using sdk::cap_force;
+using sdk::rolling_velocity;
+using sdk::tangent_keep_length;
+using sdk::Vec3;
 
 class SdCriticalAngle {
  public:
@@ -64,7 +68,10 @@ class SdCriticalAngle {
       throw sdk::ParameterError("sd_critical_angle: critical_angle must lie in (0, 90) degrees");
   }
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
+    // The pair's mu_r = tan(theta_c) when the scenario sets one for this
+    // material pair (abi.h, domel_pair_v2::rolling_friction), else ours.
+    const double tan_c = b.pair->has_rolling_friction != 0 ? b.pair->rolling_friction : tan_c_;
     // Two passes, so that the common case (elastic) runs vectorised and
     // without divisions: the elastic pass, then the few yielded contacts
     // redone from the angle it stored (the same expressions, so the results
@@ -76,7 +83,7 @@ class SdCriticalAngle {
       const uint32_t m = b.n - c0 < kChunk ? b.n - c0 : kChunk;
       const double* kn = tangent_ ? b.kn_tangent : b.kn;
       const double yields =
-          elastic_pass(m, s, b.dt, tan_c_, b.r_eff + c0, kn + c0, b.eta_n + c0, b.fn_elastic + c0, b.nx + c0,
+          elastic_pass(m, s, b.dt, tan_c, b.r_eff + c0, kn + c0, b.eta_n + c0, b.fn_elastic + c0, b.nx + c0,
                        b.ny + c0, b.nz + c0, b.wx + c0, b.wy + c0, b.wz + c0, b.history + static_cast<size_t>(c0) * s,
                        b.tqx + c0, b.tqy + c0, b.tqz + c0, b.rolling_stiffness + c0, b.rolling_damping + c0, yield);
       if (yields == 0.0) continue;
@@ -84,7 +91,7 @@ class SdCriticalAngle {
         if (yield[q] == 0.0) continue;
         const uint32_t c = c0 + q;
         double* th = b.history + static_cast<size_t>(c) * s;  // holds the new angle
-        const Constants p = constants(b.r_eff[c], kn[c], b.eta_n[c], b.fn_elastic[c], tan_c_);
+        const Constants p = constants(b.r_eff[c], kn[c], b.eta_n[c], b.fn_elastic[c], tan_c);
         const double k = p.k, eta = p.eta, m_ref = p.m_ref;
         const Vec3 w = rolling_velocity(b.wx[c], b.wy[c], b.wz[c], b.nx[c], b.ny[c], b.nz[c]);
         double m0 = -k * th[0], m1 = -k * th[1], m2 = -k * th[2];
@@ -131,16 +138,10 @@ class SdCriticalAngle {
       const double k = p.k, eta = p.eta, m_ref = p.m_ref;
       const double n0 = nx[c], n1 = ny[c], n2 = nz[c];
       const Vec3 w = rolling_velocity(wx[c], wy[c], wz[c], n0, n1, n2);
-      // rotate the stored angle into the current tangent plane, keeping its
-      // length: scaled by |theta| / |theta projected|, one square root of
-      // the ratio of the squares instead of two (and the cap compared in
-      // squares): the kernel's square roots were most of its time
-      const double len0sq = th[0] * th[0] + th[1] * th[1] + th[2] * th[2];
-      const double proj = th[0] * n0 + th[1] * n1 + th[2] * n2;
-      double t0 = th[0] - proj * n0, t1 = th[1] - proj * n1, t2 = th[2] - proj * n2;
-      const double len1sq = t0 * t0 + t1 * t1 + t2 * t2;
-      const double keep = len1sq > 0.0 ? std::sqrt(len0sq / len1sq) : 1.0;
-      t0 = t0 * keep + w.x * dt; t1 = t1 * keep + w.y * dt; t2 = t2 * keep + w.z * dt;
+      // the stored angle carried into the current tangent plane, its length
+      // kept (sdk/kinematics.hpp, physics.md §3.4), then the increment
+      const Vec3 t = tangent_keep_length(th[0], th[1], th[2], n0, n1, n2);
+      const double t0 = t.x + w.x * dt, t1 = t.y + w.y * dt, t2 = t.z + w.z * dt;
       const double m0 = -k * t0, m1 = -k * t1, m2 = -k * t2;
       const double ms_sq = m0 * m0 + m1 * m1 + m2 * m2;
       const double flag = ms_sq > m_ref * m_ref ? 1.0 : 0.0;  // above the cap: redone in the second pass

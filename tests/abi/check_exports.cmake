@@ -1,6 +1,6 @@
 # Symbol-visibility check for plugin libraries, run by ctest:
 #   cmake -DNM=<nm> -P check_exports.cmake <library>...
-# Each library must export (as a defined dynamic symbol) domel_plugin_entry_v1
+# Each library must export (as a defined dynamic symbol) domel_plugin_entry_v2
 # and no other symbol of ours: nothing whose name starts with "domel", and,
 # once demangled, nothing from the C++ namespace domel:: (a leaked template
 # instantiation of the SDK layer would show up there).
@@ -50,14 +50,14 @@ foreach(lib IN LISTS libraries)
         continue()
       endif()
       set(name "${CMAKE_MATCH_1}")
-      if(name STREQUAL "domel_plugin_entry_v1")
+      if(name STREQUAL "domel_plugin_entry_v2")
         set(has_entry TRUE)
       elseif(name MATCHES "^domel" OR name MATCHES "domel::")
         list(APPEND failures "${lib}: exports '${name}'")
       endif()
     endforeach()
     if(NOT has_entry)
-      list(APPEND failures "${lib}: does not export domel_plugin_entry_v1 (${mode} listing)")
+      list(APPEND failures "${lib}: does not export domel_plugin_entry_v2 (${mode} listing)")
     endif()
   endforeach()
   message(STATUS "checked exports of ${lib}")

@@ -14,7 +14,7 @@ typedef struct failing_state {
   int calls;
 } failing_state;
 
-static domel_status failing_create(const char* params_json, const domel_host_v1* host, void** out_instance,
+static domel_status failing_create(const char* params_json, const domel_host_v2* host, void** out_instance,
                                    char* err, size_t err_capacity) {
   failing_state* s;
   (void)params_json;
@@ -30,7 +30,7 @@ static domel_status failing_create(const char* params_json, const domel_host_v1*
 
 static void failing_destroy(void* instance) { free(instance); }
 
-static domel_status failing_contact(void* instance, domel_contact_batch_v1* batch, char* err,
+static domel_status failing_contact(void* instance, domel_contact_batch_v2* batch, char* err,
                                     size_t err_capacity) {
   failing_state* s = (failing_state*)instance;
   s->calls += 1;
@@ -39,12 +39,13 @@ static domel_status failing_contact(void* instance, domel_contact_batch_v1* batc
   return DOMEL_ERR_RUNTIME;
 }
 
-static const domel_model_v1 kModel = {
-    sizeof(domel_model_v1), DOMEL_KIND_TWISTING, "abi_failing_twisting", "1.0.0",
-    "ABI test model: its kernel always fails", "{\"type\": \"object\"}", 0u, 0u,
-    failing_create, failing_destroy, failing_contact, NULL};
-static const domel_model_v1* const kModels[] = {&kModel};
-static const domel_library_v1 kLibrary = {
-    sizeof(domel_library_v1), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "abi_failing", "1.0.0", 1u, kModels};
+static const domel_contact_family_v2 kFamily = {sizeof(domel_contact_family_v2), 0u, failing_contact};
+static const domel_model_v2 kModel = {
+    sizeof(domel_model_v2), DOMEL_KIND_TWISTING, "abi_failing_twisting", "1.0.0",
+    "ABI test model: its kernel always fails", "{\"type\": \"object\"}",
+    failing_create, failing_destroy, &kFamily};
+static const domel_model_v2* const kModels[] = {&kModel};
+static const domel_library_v2 kLibrary = {
+    sizeof(domel_library_v2), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "abi_failing", "1.0.0", 1u, kModels};
 
-DOMEL_EXPORT const domel_library_v1* domel_plugin_entry_v1(void) { return &kLibrary; }
+DOMEL_EXPORT const domel_library_v2* domel_plugin_entry_v2(void) { return &kLibrary; }

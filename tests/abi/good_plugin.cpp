@@ -38,7 +38,7 @@ class GoodRolling {
                                        std::to_string(mu_r_));
   }
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     for (uint32_t c = 0; c < b.n; ++c) {
       const double w = std::sqrt(b.wx[c] * b.wx[c] + b.wy[c] * b.wy[c] + b.wz[c] * b.wz[c]);
       if (w == 0.0) continue;

@@ -15,11 +15,16 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <unistd.h>
 
+#include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -65,7 +70,7 @@ std::string refusal(PluginRegistry& registry, const fs::path& file) {
 struct Batch {
   explicit Batch(uint32_t n)
       : overlap(n, 1e-5), nx(n, 0.0), ny(n, 0.0), nz(n, 1.0), r_eff(n, 5e-4), m_eff(n, 1e-3), radius_i(n, 1e-3),
-        radius_j(n, 1e-3), vn(n, 0.1), vt(n, 0.0), wx(n, 0.0), wy(n, 0.0), wz(n, 10.0), out(n, 0.0),
+        radius_j(n, 1e-3), mass(n, 2e-3), vn(n, 0.1), vt(n, 0.0), wx(n, 0.0), wy(n, 0.0), wz(n, 10.0), out(n, 0.0),
         fn(n, 2.0), tqx(n, 0.0), tqy(n, 0.0), tqz(n, 0.0) {
     pair.struct_size = sizeof pair;
     pair.youngs_eff = 1e7;
@@ -81,6 +86,7 @@ struct Batch {
     b.nx = nx.data(); b.ny = ny.data(); b.nz = nz.data();
     b.r_eff = r_eff.data(); b.m_eff = m_eff.data();
     b.radius_i = radius_i.data(); b.radius_j = radius_j.data();
+    b.mass_i = mass.data(); b.mass_j = mass.data();
     b.vn = vn.data();
     b.vtx = vt.data(); b.vty = vt.data(); b.vtz = vt.data();
     b.wx = wx.data(); b.wy = wy.data(); b.wz = wz.data();
@@ -90,15 +96,18 @@ struct Batch {
     b.ftx = out.data(); b.fty = out.data(); b.ftz = out.data();
     b.tqx = tqx.data(); b.tqy = tqy.data(); b.tqz = tqz.data();
   }
-  domel_pair_v1 pair{};
-  std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, vn, vt, wx, wy, wz, out, fn, tqx, tqy, tqz;
-  domel_contact_batch_v1 b{};
+  domel_pair_v2 pair{};
+  std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, mass, vn, vt, wx, wy, wz, out, fn, tqx, tqy, tqz;
+  domel_contact_batch_v2 b{};
 };
 
 /// Every broken library of tests/abi/broken, by file stem.
-const std::vector<std::string> kBroken = {"abi_major_2",      "entry_v2_only", "not_a_plugin",
-                                          "missing_create",   "missing_contact", "no_models",
-                                          "duplicate_within", "bad_schema",    "newer_minor"};
+const std::vector<std::string> kBroken = {"abi1_plugin",      "abi_major_3",      "entry_v3_only",
+                                          "not_a_plugin",     "missing_create",   "missing_contact",
+                                          "missing_control",  "missing_exchange", "no_models",
+                                          "duplicate_within", "bad_schema",       "newer_minor"};
+
+const std::string kRuntime = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR);
 
 }  // namespace
 
@@ -123,23 +132,35 @@ TEST(AbiLoader, ValidPluginsLoadAndRun) {
   EXPECT_EQ(batch.tqx[0], 0.0);
 }
 
-// Guards case (a): a library descriptor with ABI major 2 is refused on the major.
-TEST(AbiLoader, RefusesAbiMajorMismatch) {
+// Guards the ABI-1 policy (docs/sdk-guide.md, "Versions"): a plugin built against SDK 1.1
+// (domel_plugin_entry_v1) is refused, naming its ABI 1.1, this runtime's ABI and the fix.
+TEST(AbiLoader, RefusesAbi1PluginNamingBothVersions) {
   PluginRegistry registry;
-  const std::string m = refusal(registry, broken("abi_major_2"));
-  EXPECT_CONTAINS(m, "library 'abi_major_2'");
-  EXPECT_CONTAINS(m, "built against domel SDK ABI 2.0");
-  EXPECT_CONTAINS(m, "needs ABI major " + std::to_string(DOMEL_ABI_MAJOR));
+  const std::string m = refusal(registry, broken("abi1_plugin"));
+  EXPECT_CONTAINS(m, "library 'abi1_plugin' 0.9.0 was built for domel ABI 1.1");
+  EXPECT_CONTAINS(m, "this runtime speaks ABI " + kRuntime);
+  EXPECT_CONTAINS(m, "rebuild it against domel SDK " + std::to_string(DOMEL_ABI_MAJOR));
   EXPECT_TRUE(registry.models().empty());
 }
 
-// Guards case (b): an SDK-2 plugin (only domel_plugin_entry_v2) is named as such, not as "not a plugin".
-TEST(AbiLoader, RefusesEntryOfAnotherMajor) {
+// Guards case (a), the future direction: a library description claiming ABI 3.0 is refused on the major,
+// naming both versions.
+TEST(AbiLoader, RefusesFutureAbiMajorNamingBothVersions) {
   PluginRegistry registry;
-  const std::string m = refusal(registry, broken("entry_v2_only"));
-  EXPECT_CONTAINS(m, "exports 'domel_plugin_entry_v2'");
-  EXPECT_CONTAINS(m, "built against domel SDK ABI 2.x");
-  EXPECT_CONTAINS(m, "loads ABI " + std::to_string(DOMEL_ABI_MAJOR) + ".x plugins");
+  const std::string m = refusal(registry, broken("abi_major_3"));
+  EXPECT_CONTAINS(m, "library 'abi_major_3'");
+  EXPECT_CONTAINS(m, "built for domel ABI 3.0");
+  EXPECT_CONTAINS(m, "this runtime speaks ABI " + kRuntime);
+  EXPECT_TRUE(registry.models().empty());
+}
+
+// Guards case (b): an SDK-3 plugin (only domel_plugin_entry_v3) is named as such, not as "not a plugin".
+TEST(AbiLoader, RefusesEntryOfAFutureMajor) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("entry_v3_only"));
+  EXPECT_CONTAINS(m, "exports 'domel_plugin_entry_v3'");
+  EXPECT_CONTAINS(m, "built for domel ABI 3.x");
+  EXPECT_CONTAINS(m, "this runtime speaks ABI " + kRuntime);
 }
 
 // Guards case (c): a shared library without the entry symbol is refused as "not a domel plugin".
@@ -147,7 +168,7 @@ TEST(AbiLoader, RefusesLibraryWithoutEntrySymbol) {
   PluginRegistry registry;
   const std::string m = refusal(registry, broken("not_a_plugin"));
   EXPECT_CONTAINS(m, "not a domel plugin");
-  EXPECT_CONTAINS(m, "does not export 'domel_plugin_entry_v1'");
+  EXPECT_CONTAINS(m, "does not export 'domel_plugin_entry_v2'");
 }
 
 // Guards case (d): a model whose create is NULL is refused, naming the model and 'create'.
@@ -158,12 +179,30 @@ TEST(AbiLoader, RefusesModelWithoutCreate) {
   EXPECT_CONTAINS(m, "lacks required member 'create'");
 }
 
-// Guards case (e): a contact-kind model whose contact kernel is NULL is refused, naming 'contact'.
+// Guards case (e): a contact-kind model whose family table has a NULL kernel is refused, naming 'contact'.
 TEST(AbiLoader, RefusesContactModelWithoutKernel) {
   PluginRegistry registry;
   const std::string m = refusal(registry, broken("missing_contact"));
   EXPECT_CONTAINS(m, "tangential model 'missing_contact_tangential'");
-  EXPECT_CONTAINS(m, "lacks required member 'contact'");
+  EXPECT_CONTAINS(m, "lacks required callback 'contact' (domel_contact_family_v2)");
+}
+
+// Guards case (e) for the controller family: a table whose struct_size ends before 'control' is refused, naming it.
+TEST(AbiLoader, RefusesControllerWithTruncatedTable) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("missing_control"));
+  EXPECT_CONTAINS(m, "controller model 'missing_control_controller'");
+  EXPECT_CONTAINS(m, "lacks required callback 'control'");
+  EXPECT_CONTAINS(m, "domel_controller_family_v1 is " + std::to_string(offsetof(domel_controller_family_v1, control)) +
+                         " bytes");
+}
+
+// Guards case (e) for the fluid_coupler family: a NULL 'exchange' is refused, naming it.
+TEST(AbiLoader, RefusesFluidCouplerWithoutExchange) {
+  PluginRegistry registry;
+  const std::string m = refusal(registry, broken("missing_exchange"));
+  EXPECT_CONTAINS(m, "fluid_coupler model 'missing_exchange_coupler'");
+  EXPECT_CONTAINS(m, "lacks required callback 'exchange' (domel_fluid_coupler_family_v1)");
 }
 
 // Guards case (f): a library with model_count 0 is refused as registering nothing.
@@ -210,7 +249,7 @@ TEST(AbiLoader, RefusesNewerAbiMinor) {
   const std::string m = refusal(registry, broken("newer_minor"));
   EXPECT_CONTAINS(m, "newer");
   EXPECT_CONTAINS(m, "ABI " + std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR + 1));
-  EXPECT_CONTAINS(m, "supports up to " + std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR));
+  EXPECT_CONTAINS(m, "supports up to " + kRuntime);
 }
 
 // Guards case (j): a path that does not exist is refused with "not found".
@@ -260,7 +299,7 @@ TEST(AbiLoader, KernelFailureBecomesPluginError) {
     } catch (const PluginError& e) {
       const std::string m = e.what();
       if (call == 0) std::cout << "[kernel failure] " << m << "\n";
-      EXPECT_CONTAINS(m, "twisting model 'abi_failing_twisting' failed");
+      EXPECT_CONTAINS(m, "twisting model 'abi_failing_twisting' (library 'abi_failing') at test: contact kernel failed");
       EXPECT_CONTAINS(m, "deliberate failure on a batch of 3 contacts");
     }
   }
@@ -307,7 +346,7 @@ TEST(AbiLoader, LoadDirectoryKeepsGoodAndRecordsBroken) {
     ASSERT_EQ(registry.refused().size(), 1u);
     std::cout << "[refused()] " << registry.refused()[0] << "\n";
     EXPECT_CONTAINS(registry.refused()[0], "plugin '" + shown(broken_copy) + "' refused: ");
-    EXPECT_CONTAINS(registry.refused()[0], "lacks required member 'contact'");
+    EXPECT_CONTAINS(registry.refused()[0], "lacks required callback 'contact'");
   }
   fs::remove_all(dir);
 }
@@ -336,7 +375,137 @@ TEST(AbiLoader, LoadingSamePathTwiceIsNoOp) {
   registry.load(fs::path(DOMEL_ABI_GOOD_DIR) / ".." / "good" / good("good_plugin").filename());
   EXPECT_EQ(registry.libraries().size(), 1u);
   EXPECT_EQ(registry.models().size(), 1u);
-  EXPECT_EQ(registry.load_directory(DOMEL_ABI_GOOD_DIR), 2u);  // load() counts the no-op as loaded
-  EXPECT_EQ(registry.libraries().size(), 2u);                  // only failing_kernel is new
+  EXPECT_EQ(registry.load_directory(DOMEL_ABI_GOOD_DIR), 3u);  // load() counts the no-op as loaded
+  EXPECT_EQ(registry.libraries().size(), 3u);                  // only failing_kernel and family_plugins are new
   EXPECT_TRUE(registry.refused().empty());
+}
+
+namespace {
+
+/// One level's views for the controller and fluid_coupler tests: a 2x1x1
+/// grid of 1 m cells from the origin, and particles, all owned here.
+struct Level {
+  Level(const char* name, std::vector<double> px, std::vector<double> pvx, std::vector<uint32_t> pcell)
+      : x(std::move(px)), vx(std::move(pvx)), cell(std::move(pcell)) {
+    const std::size_t n = x.size();
+    id.resize(n);
+    for (std::size_t k = 0; k < n; ++k) id[k] = 100 + k;
+    y.assign(n, 0.5); z.assign(n, 0.5); vy.assign(n, 0.0); vz.assign(n, 0.0);
+    mass.assign(n, 2.0); radius.assign(n, 0.01); fx.assign(n, 0.0); fy.assign(n, 0.0); fz.assign(n, 0.0);
+    grid.struct_size = sizeof grid;
+    grid.nx = 2; grid.ny = 1; grid.nz = 1;
+    for (int d = 0; d < 3; ++d) { grid.origin[d] = 0.0; grid.spacing[d] = 1.0; }
+    grid.n_cells = 2;
+    grid.count = count.data(); grid.volume_fraction = phi.data(); grid.mass = cmass.data();
+    grid.ux = ux.data(); grid.uy = zero.data(); grid.uz = zero.data();
+    grid.u_min_x = zero.data(); grid.u_min_y = zero.data(); grid.u_min_z = umin_z.data();
+    grid.u_max_x = zero.data(); grid.u_max_y = zero.data(); grid.u_max_z = umax_z.data();
+    grid.stress = stress.data();
+    particles = {static_cast<uint32_t>(sizeof particles), 0, n, id.data(), x.data(), y.data(), z.data(), vx.data(), vy.data(),
+                 vz.data(), mass.data(), radius.data(), cell.data(), fx.data(), fy.data(), fz.data()};
+    level = {static_cast<uint32_t>(sizeof level), 0, name, 1.0, &grid, &particles};
+  }
+  std::vector<double> x, y, z, vx, vy, vz, mass, radius, fx, fy, fz;
+  std::vector<uint64_t> id;
+  std::vector<uint32_t> cell;
+  std::vector<uint32_t> count = {3, 1};
+  std::vector<double> phi = {0.25, 0.5}, cmass = {6.0, 2.0}, ux = {1.5, -0.5}, zero = {0.0, 0.0},
+                      umin_z = {-0.2, 0.1}, umax_z = {0.3, 0.4}, stress = std::vector<double>(12, 0.0);
+  domel_cell_grid_v1 grid{};
+  domel_particles_v1 particles{};
+  domel_level_v1 level{};
+};
+
+/// Captures the default logger's output while alive.
+struct LogCapture {
+  LogCapture() : old(spdlog::default_logger()) {
+    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
+    auto logger = std::make_shared<spdlog::logger>("capture", sink);
+    logger->set_level(spdlog::level::debug);
+    spdlog::set_default_logger(logger);
+  }
+  ~LogCapture() { spdlog::set_default_logger(old); }
+  std::ostringstream text;
+  std::shared_ptr<spdlog::logger> old;
+};
+
+}  // namespace
+
+// Guards the controller family (abi.h, domel_controller_family_v1): the model loads, the loader's
+// ModelInstance calls `control` with two levels' cell averages (incl. min/max velocity) and particles,
+// the forces it writes to both levels arrive, the instance keeps its state between calls, and its
+// host log lines carry its kind, name, library and location.
+TEST(AbiFamilies, ControllerReadsBothLevelsAndWritesForcesToBoth) {
+  PluginRegistry registry;
+  registry.load(good("family_plugins"));
+  const auto* model = registry.find(DOMEL_KIND_CONTROLLER, "abi_test_controller");
+  ASSERT_NE(model, nullptr);
+  EXPECT_EQ(model->library_name, "abi_families");
+  ModelInstance instance(*model, {{"gain", 10.0}}, "scenario.json: at /couplings/0");
+  // level 0 (fine): particles at x = 0.5 (coarse cell 0) and 1.5 (cell 1); level 1 (coarse): in cells 1 and 0.
+  Level fine("fine", {0.5, 1.5}, {1.0, 0.0}, {0, 1});
+  Level coarse("coarse", {1.2, 0.7}, {0.0, 0.0}, {1, 0});
+  domel_level_v1* levels[] = {&fine.level, &coarse.level};
+  domel_control_step_v1 step{static_cast<uint32_t>(sizeof step), 2, 0.25, 0.01, levels};
+  LogCapture log;
+  instance.control(step);
+  instance.control(step);
+  // fine: F_x = gain m (u_x(coarse cell) - v_x), added over two calls
+  EXPECT_DOUBLE_EQ(fine.fx[0], 2 * 10.0 * 2.0 * (1.5 - 1.0));
+  EXPECT_DOUBLE_EQ(fine.fx[1], 2 * 10.0 * 2.0 * (-0.5 - 0.0));
+  // coarse: F_z = -m (u_max_z - u_min_z) of its own cell; F_y = calls so far (1 + 2)
+  EXPECT_DOUBLE_EQ(coarse.fz[0], 2 * -2.0 * (0.4 - 0.1));
+  EXPECT_DOUBLE_EQ(coarse.fz[1], 2 * -2.0 * (0.3 - -0.2));
+  EXPECT_DOUBLE_EQ(coarse.fy[0], 3.0);
+  const std::string logged = log.text.str();
+  std::cout << "[controller log] " << logged;
+  EXPECT_CONTAINS(logged, "[controller model 'abi_test_controller' (library 'abi_families') at scenario.json: at "
+                          "/couplings/0] control call 2");
+  // one level is not enough for this controller: its message arrives with the context
+  step.level_count = 1;
+  try {
+    instance.control(step);
+    ADD_FAILURE() << "a step with one level was accepted";
+  } catch (const PluginError& e) {
+    EXPECT_CONTAINS(e.what(), "controller model 'abi_test_controller' (library 'abi_families') at scenario.json: at "
+                              "/couplings/0: control failed: needs two levels, got 1");
+  }
+}
+
+// Guards the fluid_coupler family (domel_fluid_coupler_family_v1): `exchange` is called through
+// ModelInstance and returns per-particle fluid forces; an error reported through the host's error
+// service is kept with the instance's context and the failure carries the plugin's message.
+TEST(AbiFamilies, FluidCouplerReturnsPerParticleForcesAndReportsErrorsWithContext) {
+  PluginRegistry registry;
+  registry.load(good("family_plugins"));
+  const auto* model = registry.find(DOMEL_KIND_FLUID_COUPLER, "abi_test_drag");
+  ASSERT_NE(model, nullptr);
+  ModelInstance instance(*model, {{"viscosity", 1e-3}, {"flow_x", 2.0}}, "test");
+  Level level("bed", {0.5, 1.5}, {1.0, 3.0}, {0, 1});
+  domel_fluid_exchange_v1 ex{static_cast<uint32_t>(sizeof ex), 0, 1.0, 1e-3, &level.level};
+  instance.exchange(ex);
+  const double stokes = 6.0 * M_PI * 1e-3 * 0.01;
+  EXPECT_DOUBLE_EQ(level.fx[0], stokes * (2.0 - 1.0) * (1.0 - 0.25));
+  EXPECT_DOUBLE_EQ(level.fx[1], stokes * (2.0 - 3.0) * (1.0 - 0.5));
+  // without a grid: no (1 - phi) factor
+  level.level.cells = nullptr;
+  level.fx.assign(2, 0.0);
+  instance.exchange(ex);
+  EXPECT_DOUBLE_EQ(level.fx[0], stokes * (2.0 - 1.0));
+
+  level.level.particles = nullptr;
+  LogCapture log;
+  try {
+    instance.exchange(ex);
+    ADD_FAILURE() << "an exchange without particles was accepted";
+  } catch (const PluginError& e) {
+    EXPECT_CONTAINS(e.what(), "fluid_coupler model 'abi_test_drag' (library 'abi_families') at test: exchange failed: "
+                              "nothing to couple");
+  }
+  EXPECT_EQ(instance.last_error(), "level 'bed' handed no particles to couple");
+  EXPECT_CONTAINS(log.text.str(), "[fluid_coupler model 'abi_test_drag' (library 'abi_families') at test] error 2: "
+                                  "level 'bed' handed no particles to couple");
+  // a contact-family call on a fluid coupler is refused by the wrapper, not sent to a null pointer
+  domel_control_step_v1 step{static_cast<uint32_t>(sizeof step), 0, 0.0, 0.0, nullptr};
+  EXPECT_THROW(instance.control(step), PluginError);
 }

@@ -33,7 +33,7 @@ cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1 || {
   cat "$tmp/install.log" >&2
   fail "cmake --install failed"
 }
-for f in include/domel/sdk/abi.h include/domel/sdk/plugin.hpp \
+for f in include/domel/sdk/abi.h include/domel/sdk/plugin.hpp include/domel/sdk/kinematics.hpp \
          lib/cmake/domel_sdk/domel_sdkConfig.cmake lib/cmake/domel_sdk/domel_sdkConfigVersion.cmake \
          lib/cmake/domel_sdk/domel_sdk_targets.cmake lib/cmake/domel_sdk/DomelPlugin.cmake; do
   [[ -f "$prefix/$f" ]] || { (cd "$prefix" && find . -type f | sort) >&2; fail "not installed: $f"; }

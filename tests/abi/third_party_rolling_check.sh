@@ -4,7 +4,7 @@
 # Builds the EPSD example exactly as a third party would and runs it:
 # 1. installs the built domel project into a temporary prefix;
 # 2. configures and builds the example project against that prefix only
-#    (find_package(domel_sdk 1.1) + domel_add_plugin) into $tmp/build;
+#    (find_package(domel_sdk 2.0) + domel_add_plugin) into $tmp/build;
 # 3. copies scenario.json next to the built libdomel_rolling_epsd.so (the
 #    scenario names it by a path relative to itself), runs it with the
 #    installed domel, and checks summary.json: rolling model "epsd" from the

@@ -1,5 +1,5 @@
 // Guards the rolling-resistance kernels themselves, called directly on a
-// hand-built domel_contact_batch_v1 (no platform in between), issue
+// hand-built domel_contact_batch_v2 (no platform in between), issue
 // acceptance 6(b):
 //  - sd_critical_angle (docs/physics.md §3.2–§3.4): driven at a constant
 //    rolling angular velocity, the torque follows the spring–dashpot law
@@ -59,7 +59,8 @@ V3 in_plane(const V3& a, const V3& n) {
 /// A hand-built batch of n contacts: owns every array the ABI names.
 struct Batch {
   explicit Batch(uint32_t n, uint32_t stride = 3)
-      : overlap(n, 1e-6), nx(n), ny(n), nz(n), r_eff(n), m_eff(n, 1e-5), radius_i(n), radius_j(n), vn(n),
+      : overlap(n, 1e-6), nx(n), ny(n), nz(n), r_eff(n), m_eff(n, 1e-5), radius_i(n), radius_j(n), mass_i(n, 2e-5),
+        mass_j(n, 2e-5), vn(n),
         vtx(n), vty(n), vtz(n), wx(n), wy(n), wz(n), fn_elastic(n), kn(n), kn_tangent(n), contact_radius(n),
         fn_damping(n), eta_n(n), fn(n), ftx(n), fty(n), ftz(n), tqx(n), tqy(n), tqz(n), history(n * stride),
         rolling_stiffness(n), rolling_damping(n) {
@@ -76,6 +77,7 @@ struct Batch {
     b.nx = nx.data(); b.ny = ny.data(); b.nz = nz.data();
     b.r_eff = r_eff.data(); b.m_eff = m_eff.data();
     b.radius_i = radius_i.data(); b.radius_j = radius_j.data();
+    b.mass_i = mass_i.data(); b.mass_j = mass_j.data();
     b.vn = vn.data();
     b.vtx = vtx.data(); b.vty = vty.data(); b.vtz = vtz.data();
     b.wx = wx.data(); b.wy = wy.data(); b.wz = wz.data();
@@ -107,11 +109,12 @@ struct Batch {
     std::fill(rolling_damping.begin(), rolling_damping.end(), 0.0);
   }
 
-  domel_pair_v1 pair{};
-  std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, vn, vtx, vty, vtz, wx, wy, wz;
+  domel_pair_v2 pair{};
+  std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, mass_i, mass_j, vn, vtx, vty, vtz, wx,
+      wy, wz;
   std::vector<double> fn_elastic, kn, kn_tangent, contact_radius, fn_damping, eta_n, fn;
   std::vector<double> ftx, fty, ftz, tqx, tqy, tqz, history, rolling_stiffness, rolling_damping;
-  domel_contact_batch_v1 b{};
+  domel_contact_batch_v2 b{};
 };
 
 /// One contact of the parameter sweep.
@@ -429,4 +432,68 @@ TEST(RollingKernel, DctPureTwistAboutGenericNormalGivesNoTorque) {
   std::printf("[dct pure twist] %d of %u random normals get a torque (full magnitude %.3e N m)\n", with_torque, n,
               full);
   EXPECT_EQ(with_torque, 0);
+}
+
+// Guards the per-pair rolling friction of ABI 2 (abi.h, domel_pair_v2):
+// with has_rolling_friction set, dct and sd_critical_angle use the pair's
+// mu_r (= tan theta_c) instead of their own parameter; unset, their own.
+TEST(RollingKernel, PairRollingFrictionOverridesTheModelsOwn) {
+  const Dct dct{Params(json{{"rolling_friction", 0.1}})};
+  const SdCriticalAngle sd{Params(json{{"critical_angle", 30.0}})};
+  for (const bool by_pair : {false, true}) {
+    Batch bt(1, 3);
+    bt.pair.has_rolling_friction = by_pair ? 1u : 0u;
+    bt.pair.rolling_friction = 0.25;
+    bt.set_normal(0, {0, 0, 1});
+    bt.set_omega(0, {2.0, 0, 0});
+    bt.r_eff[0] = 1e-3;
+    bt.fn_elastic[0] = 2.0;
+    bt.kn_tangent[0] = bt.kn[0] = 1e5;
+    dct.compute(bt.b);
+    const double mu = by_pair ? 0.25 : 0.1;
+    EXPECT_NEAR(bt.tqx[0], -mu * 1e-3 * 2.0, 1e-15) << "dct, by_pair " << by_pair;
+    bt.clear_outputs();
+    sd.compute(bt.b);
+    const double a = 1e-3 * (by_pair ? 0.25 : std::tan(30.0 * kDeg));
+    EXPECT_NEAR(bt.rolling_stiffness[0], 0.25 * 1e5 * a * a, 1e-12 * 0.25 * 1e5 * a * a) << "sd, by_pair " << by_pair;
+  }
+}
+
+// Guards the SDK's split of a batch of several material pairs (abi.h: pair
+// NULL, pair_of per contact) into runs of one pair: through the generated C
+// callback, every contact gets its own pair's mu_r, bit for bit as in
+// uniform batches of each pair.
+TEST(RollingKernel, MixedPairBatchIsSplitIntoRunsOfOnePair) {
+  using Export = domel::sdk::detail::Export<Dct>;
+  void* inst = nullptr;
+  char err[256] = {0};
+  ASSERT_EQ(Export::create(R"({"rolling_friction": 0.1})", nullptr, &inst, err, sizeof err), DOMEL_OK) << err;
+  const uint32_t n = 7;
+  Batch mixed(n, 0);
+  domel_pair_v2 a = mixed.pair, b = mixed.pair;
+  a.has_rolling_friction = 1; a.rolling_friction = 0.2;
+  b.has_rolling_friction = 1; b.rolling_friction = 0.4;
+  const std::vector<const domel_pair_v2*> pair_of = {&a, &a, &a, &b, &b, &a, &b};
+  mixed.b.pair = nullptr;
+  mixed.b.pair_of = pair_of.data();
+  for (uint32_t c = 0; c < n; ++c) {
+    mixed.set_normal(c, unit({0.1 * c, 1.0, 0.3}));
+    mixed.set_omega(c, {1.0 + c, -2.0, 0.5});
+    mixed.r_eff[c] = 1e-3 * (1 + c);
+    mixed.fn_elastic[c] = 0.5 + c;
+  }
+  ASSERT_EQ(Export::contact(inst, &mixed.b, err, sizeof err), DOMEL_OK) << err;
+  for (uint32_t c = 0; c < n; ++c) {
+    Batch one(1, 0);
+    one.pair = *pair_of[c];
+    one.set_normal(0, {mixed.nx[c], mixed.ny[c], mixed.nz[c]});
+    one.set_omega(0, {mixed.wx[c], mixed.wy[c], mixed.wz[c]});
+    one.r_eff[0] = mixed.r_eff[c];
+    one.fn_elastic[0] = mixed.fn_elastic[c];
+    ASSERT_EQ(Export::contact(inst, &one.b, err, sizeof err), DOMEL_OK) << err;
+    EXPECT_EQ(one.tqx[0], mixed.tqx[c]) << c;
+    EXPECT_EQ(one.tqy[0], mixed.tqy[c]) << c;
+    EXPECT_EQ(one.tqz[0], mixed.tqz[c]) << c;
+  }
+  Export::destroy(inst);
 }

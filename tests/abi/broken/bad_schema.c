@@ -6,11 +6,11 @@
  */
 #include "stub_callbacks.h"
 
-static const domel_model_v1 kModel = {
-    sizeof(domel_model_v1), DOMEL_KIND_ROLLING, "bad_schema_rolling", "1.0.0", "schema is not JSON",
-    "{\"type\": object", 0u, 0u, stub_create, stub_destroy, stub_contact, NULL};
-static const domel_model_v1* const kModels[] = {&kModel};
-static const domel_library_v1 kLibrary = {
-    sizeof(domel_library_v1), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "bad_schema", "1.0.0", 1u, kModels};
+static const domel_model_v2 kModel = {
+    sizeof(domel_model_v2), DOMEL_KIND_ROLLING, "bad_schema_rolling", "1.0.0", "schema is not JSON",
+    "{\"type\": object", stub_create, stub_destroy, &stub_contact_family};
+static const domel_model_v2* const kModels[] = {&kModel};
+static const domel_library_v2 kLibrary = {
+    sizeof(domel_library_v2), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "bad_schema", "1.0.0", 1u, kModels};
 
-DOMEL_EXPORT const domel_library_v1* domel_plugin_entry_v1(void) { return &kLibrary; }
+DOMEL_EXPORT const domel_library_v2* domel_plugin_entry_v2(void) { return &kLibrary; }

@@ -17,7 +17,7 @@ class UniqueDamping {
   static constexpr const char* kSummary = "would be fine on its own";
   static constexpr const char* kSchema = R"json({"type": "object"})json";
   explicit UniqueDamping(const domel::sdk::Params&) {}
-  void compute(domel_contact_batch_v1&) const {}
+  void compute(domel_contact_batch_v2&) const {}
 };
 
 class SameNameRolling {
@@ -28,7 +28,7 @@ class SameNameRolling {
   static constexpr const char* kSummary = "clashes with the good plugin";
   static constexpr const char* kSchema = R"json({"type": "object"})json";
   explicit SameNameRolling(const domel::sdk::Params&) {}
-  void compute(domel_contact_batch_v1&) const {}
+  void compute(domel_contact_batch_v2&) const {}
 };
 
 }  // namespace

@@ -5,7 +5,7 @@
  */
 #include <domel/sdk/abi.h>
 
-static const domel_library_v1 kLibrary = {
-    sizeof(domel_library_v1), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "no_models", "1.0.0", 0u, NULL};
+static const domel_library_v2 kLibrary = {
+    sizeof(domel_library_v2), DOMEL_ABI_MAJOR, DOMEL_ABI_MINOR, "no_models", "1.0.0", 0u, NULL};
 
-DOMEL_EXPORT const domel_library_v1* domel_plugin_entry_v1(void) { return &kLibrary; }
+DOMEL_EXPORT const domel_library_v2* domel_plugin_entry_v2(void) { return &kLibrary; }

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT
  *
  * Shared by the hand-written C plugins of the ABI refusal tests: do-nothing
- * callbacks (create, destroy, contact) so each broken library only spells out
+ * callbacks (create, destroy, contact, and a contact family table holding
+ * the contact one) so each broken library only spells out
  * the one thing that is wrong with it. Plain C against abi.h, no C++ layer:
  * it also shows the ABI is usable from C. Everything here is static, so no
  * symbol beyond a library's own entry point is exported.
@@ -13,7 +14,7 @@
 
 static int stub_instance_storage;
 
-static domel_status stub_create(const char* params_json, const domel_host_v1* host, void** out_instance,
+static domel_status stub_create(const char* params_json, const domel_host_v2* host, void** out_instance,
                                 char* err, size_t err_capacity) {
   (void)params_json;
   (void)host;
@@ -25,7 +26,7 @@ static domel_status stub_create(const char* params_json, const domel_host_v1* ho
 
 static void stub_destroy(void* instance) { (void)instance; }
 
-static domel_status stub_contact(void* instance, domel_contact_batch_v1* batch, char* err,
+static domel_status stub_contact(void* instance, domel_contact_batch_v2* batch, char* err,
                                  size_t err_capacity) {
   (void)instance;
   (void)batch;
@@ -33,6 +34,10 @@ static domel_status stub_contact(void* instance, domel_contact_batch_v1* batch, 
   (void)err_capacity;
   return DOMEL_OK;
 }
+
+/* Only some libraries use the table; unused there, hence the attribute. */
+__attribute__((unused)) static const domel_contact_family_v2 stub_contact_family = {
+    sizeof(domel_contact_family_v2), 0u, stub_contact};
 
 #define STUB_SCHEMA "{\"type\": \"object\"}"
 

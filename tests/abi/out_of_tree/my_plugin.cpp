@@ -30,7 +30,7 @@ class OotLinear {
     if (!(k_ > 0.0)) throw domel::sdk::ParameterError("oot_linear: 'stiffness' must be positive");
   }
 
-  void compute(domel_contact_batch_v1& b) const {
+  void compute(domel_contact_batch_v2& b) const {
     for (uint32_t c = 0; c < b.n; ++c) {
       b.fn_elastic[c] = k_ * b.overlap[c];
       b.kn[c] = k_;

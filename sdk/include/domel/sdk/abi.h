@@ -1,18 +1,31 @@
 /* SPDX-License-Identifier: MIT
  *
- * domel SDK — the C ABI between the domel runtime and its plugins.
+ * domel SDK — the C ABI between the domel runtime and its plugins (ABI 2).
  *
  * This header is the single source of truth for the binary boundary. It is
  * plain C so a plugin may be built with any compiler and standard library:
  * no STL, Eigen, nlohmann or exceptions cross it. Rules (see docs/sdk-guide.md):
  *
- *  - A plugin library exports exactly one symbol, domel_plugin_entry_v1, that
- *    returns a static domel_library_v1 describing every model it provides.
- *    A future incompatible ABI exports domel_plugin_entry_v2 instead.
+ *  - A plugin library exports exactly one symbol, domel_plugin_entry_v2, that
+ *    returns a static domel_library_v2 describing every model it provides.
+ *    Each model descriptor (domel_model_v2) carries the common members (kind,
+ *    name, version, schema, create/destroy) and a pointer to the callback
+ *    table of its FAMILY: contact stages (normal, damping, tangential,
+ *    rolling, twisting) -> domel_contact_family_v2, insertion ->
+ *    domel_insertion_family_v2, controller -> domel_controller_family_v1,
+ *    fluid coupler -> domel_fluid_coupler_family_v1. Adding a family adds a
+ *    table; it never changes an existing one (the OBS module pattern).
  *  - Every struct begins with its own size (struct_size). Minor ABI versions
- *    only append fields; the host zero-fills what an older plugin lacks.
+ *    only append fields; the host zero-fills what an older plugin lacks. A
+ *    required callback that is missing (or lies beyond a table's struct_size)
+ *    is refused at load time, naming the callback.
+ *  - ABI 1 plugins (domel_plugin_entry_v1) are refused with a message naming
+ *    both versions; so is a plugin of a future major (entry_v3, or
+ *    abi_major 3 in the library description). docs/sdk-guide.md, "Versions".
  *  - Errors come back as a domel_status plus a message written into a
- *    caller-owned buffer.
+ *    caller-owned buffer; the host adds the context (model, library, scenario
+ *    location). Host services (domel_host_v2) let a plugin log and report
+ *    errors under its own name.
  *  - Kernels work on batches: the host hands over N contacts as
  *    structure-of-arrays pointers; there is never one call per contact.
  *
@@ -27,8 +40,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define DOMEL_ABI_MAJOR 1
-#define DOMEL_ABI_MINOR 1
+#define DOMEL_ABI_MAJOR 2
+#define DOMEL_ABI_MINOR 0
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -44,52 +57,86 @@ extern "C" {
 typedef enum domel_status {
   DOMEL_OK = 0,
   DOMEL_ERR_PARAMETER = 1, /**< parameters rejected (create) */
-  DOMEL_ERR_RUNTIME = 2,   /**< a kernel could not do its work */
+  DOMEL_ERR_RUNTIME = 2,   /**< a callback could not do its work */
   DOMEL_ERR_CAPACITY = 3   /**< output buffer too small; retry with more room */
 } domel_status;
 
 /** What a model is. Contact kinds fill one slot of the contact pipeline,
  *  evaluated in this fixed order for each batch:
- *  normal -> damping -> (host sums F_n) -> tangential -> rolling -> twisting. */
+ *  normal -> damping -> (host sums F_n) -> tangential -> rolling -> twisting.
+ *  The family of each kind (which table `family` points to) is given here. */
 typedef enum domel_kind {
-  DOMEL_KIND_NORMAL = 1,     /**< elastic normal force, stiffness, contact radius */
-  DOMEL_KIND_DAMPING = 2,    /**< normal dashpot force */
-  DOMEL_KIND_TANGENTIAL = 3, /**< tangential (friction) force */
-  DOMEL_KIND_ROLLING = 4,    /**< rolling-resistance torque */
-  DOMEL_KIND_TWISTING = 5,   /**< twisting-resistance torque */
-  DOMEL_KIND_INSERTION = 10, /**< creates particle positions and radii */
-  DOMEL_KIND_FLUID = 20,     /**< reserved: fluid coupler */
-  DOMEL_KIND_CONTROLLER = 30 /**< reserved: coupling controller */
+  DOMEL_KIND_NORMAL = 1,          /**< contact family: elastic normal force, stiffness, contact radius */
+  DOMEL_KIND_DAMPING = 2,         /**< contact family: normal dashpot force */
+  DOMEL_KIND_TANGENTIAL = 3,      /**< contact family: tangential (friction) force */
+  DOMEL_KIND_ROLLING = 4,         /**< contact family: rolling-resistance torque */
+  DOMEL_KIND_TWISTING = 5,        /**< contact family: twisting-resistance torque */
+  DOMEL_KIND_INSERTION = 10,      /**< insertion family: creates particle positions and radii */
+  DOMEL_KIND_FLUID_COUPLER = 20,  /**< fluid_coupler family: per-particle fluid forces */
+  DOMEL_KIND_CONTROLLER = 30      /**< controller family: forces from the cell averages of coupled levels */
 } domel_kind;
 
-/** Services the host offers a plugin instance. */
-typedef struct domel_host_v1 {
+/* ------------------------------------------------------------------------ */
+/* Host services                                                             */
+/* ------------------------------------------------------------------------ */
+
+/** Services the host offers ONE model instance: `create` receives a pointer
+ *  that stays valid until `destroy` returns. `context` identifies the
+ *  instance, so the host prefixes every message with the model's kind and
+ *  name, its library and the scenario location that created it. */
+typedef struct domel_host_v2 {
   uint32_t struct_size;
   uint32_t abi_minor;
   void* context;
   /** level: 0 debug, 1 info, 2 warning, 3 error. Thread-safe. */
   void (*log)(void* context, int level, const char* utf8_message);
-} domel_host_v1;
+  /** Report an error with its context: the host logs it at error level,
+   *  prefixed as for log, and keeps it as the instance's last error. A
+   *  callback that then returns a failure status with an empty message
+   *  buffer is reported with this text. Thread-safe. */
+  void (*error)(void* context, domel_status code, const char* utf8_message);
+} domel_host_v2;
 
-/** Material-pair constants, the same for every contact of a batch. */
-typedef struct domel_pair_v1 {
+/* ------------------------------------------------------------------------ */
+/* Contact family                                                            */
+/* ------------------------------------------------------------------------ */
+
+/** Material-pair constants: one parameter set per pair of materials (and per
+ *  material/wall pair). A batch says per contact which set applies, see
+ *  domel_contact_batch_v2::pair and ::pair_of. */
+typedef struct domel_pair_v2 {
   uint32_t struct_size;
-  uint32_t is_wall;      /**< nonzero: j is a wall (R* = R_i, m* = m_i) */
+  uint32_t is_wall;      /**< nonzero: j is a wall (R* = R_i, m* = m_i, mass_j = 0) */
   double youngs_eff;     /**< E*: 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j  [Pa] */
   double shear_eff;      /**< G*: 1/G* = 2(2-nu_i)(1+nu_i)/E_i + (same for j)  [Pa] */
   double restitution;    /**< normal coefficient of restitution e  [-] */
   double friction;       /**< sliding friction coefficient mu  [-] */
   double coarse_grain;   /**< coarse-grain ratio alpha of the subdomain  [-] */
-} domel_pair_v1;
+  /** coefficient of rolling friction mu_r of this pair [-], valid when
+   *  has_rolling_friction is nonzero (the torque cap is mu_r R* F_n;
+   *  mu_r = tan(theta_c) for a critical rolling angle theta_c). Zero-filled,
+   *  i.e. not given for this pair: the rolling model's own parameter applies.
+   *  The built-in rolling models and the epsd example honour it. */
+  double rolling_friction;
+  uint32_t has_rolling_friction;
+  uint32_t reserved;     /**< 0 */
+} domel_pair_v2;
 
 /** A batch of n contacts, structure of arrays. Arrays marked [in] are
  *  filled by the host; [stage] arrays are written by the named stage and
  *  read by later stages; [out] arrays are this stage's result. */
-typedef struct domel_contact_batch_v1 {
+typedef struct domel_contact_batch_v2 {
   uint32_t struct_size;
   uint32_t n;
   double dt;                  /**< time step of the subdomain  [s] */
-  const domel_pair_v1* pair;  /**< material-pair constants */
+  /** Which material-pair parameter set applies to each contact:
+   *  pair != NULL: every contact of the batch uses *pair (the common case,
+   *  read once per batch); pair_of may then be NULL.
+   *  pair == NULL: contact c uses *pair_of[c]; the host groups contacts of
+   *  one pair next to each other. The C++ layer (plugin.hpp) splits such a
+   *  batch into runs of one pair, so a C++ compute() always sees pair set. */
+  const domel_pair_v2* pair;
+  const domel_pair_v2* const* pair_of;
 
   /* [in] geometry and kinematics */
   const double* overlap;      /**< delta_n > 0  [m] */
@@ -98,6 +145,8 @@ typedef struct domel_contact_batch_v1 {
   const double* m_eff;        /**< m*  [kg] */
   const double* radius_i;     /**< R_i [m] */
   const double* radius_j;     /**< R_j [m] (0 for a wall) */
+  const double* mass_i;       /**< m_i [kg] */
+  const double* mass_j;       /**< m_j [kg] (0 for a wall) */
   const double* vn;           /**< normal relative speed, > 0 when approaching  [m/s] */
   const double *vtx, *vty, *vtz; /**< tangential relative velocity of i's contact point w.r.t. j's  [m/s] */
   const double *wx, *wy, *wz; /**< relative angular velocity omega_i - omega_j  [rad/s] */
@@ -116,25 +165,40 @@ typedef struct domel_contact_batch_v1 {
   double *ftx, *fty, *ftz;
   /* [out: rolling, twisting] torque couple on i, ADDED to (j receives the opposite)  [N m] */
   double *tqx, *tqy, *tqz;
-
-  /* this stage's history: element k of contact c is history[c*history_stride + k].
-   * Zero when a contact first forms; the host keeps it across neighbour-list
-   * rebuilds and particle re-ordering, and zeroes it when the contact opens. */
-  double* history;
-  uint32_t history_stride;
-
-  /* ---- appended in ABI 1.1 ---- */
   /* [out: rolling] the rolling spring and dashpot constants of each contact,
    * k_theta [N m/rad] and n_theta [N m s/rad], for the host's rotational
    * time-step check (docs/physics.md §3.6). Zeroed by the host before the
    * rolling stage; a model without a spring or dashpot leaves them 0. */
   double* rolling_stiffness;
   double* rolling_damping;
-} domel_contact_batch_v1;
+
+  /* this stage's history: element k of contact c is history[c*history_stride + k].
+   * Zero when a contact first forms; the host keeps it across neighbour-list
+   * rebuilds and particle re-ordering, and zeroes it when the contact opens. */
+  double* history;
+  uint32_t history_stride;
+} domel_contact_batch_v2;
+
+/* Thread safety: the host may call `contact` of ONE instance from several
+ * threads at once, each with its own batch. A contact kernel must therefore
+ * not modify its instance; per-contact state belongs in history. */
+typedef domel_status (*domel_contact_fn)(void* instance, domel_contact_batch_v2* batch, char* err,
+                                         size_t err_capacity);
+
+/** Callbacks of the contact family (kinds normal ... twisting). */
+typedef struct domel_contact_family_v2 {
+  uint32_t struct_size;
+  uint32_t history_slots;   /**< doubles of per-contact history this stage needs */
+  domel_contact_fn contact; /**< required */
+} domel_contact_family_v2;
+
+/* ------------------------------------------------------------------------ */
+/* Insertion family                                                          */
+/* ------------------------------------------------------------------------ */
 
 /** An insertion region. shape 1: box [lo, hi]. shape 2: cylinder with the
  *  given axis (0 x, 1 y, 2 z) through `center`, radius `radius`, extending
- *  from lo[axis] to hi[axis]. */
+ *  from lo[axis] to hi[axis]. (Unchanged since ABI 1.) */
 typedef struct domel_region_v1 {
   uint32_t struct_size;
   uint32_t shape;
@@ -161,48 +225,163 @@ typedef struct domel_insert_output_v1 {
   double *x, *y, *z, *r;
 } domel_insert_output_v1;
 
-typedef domel_status (*domel_create_fn)(const char* params_json, const domel_host_v1* host,
+typedef domel_status (*domel_insert_fn)(void* instance, const domel_insert_request_v1* request,
+                                        domel_insert_output_v1* output, char* err, size_t err_capacity);
+
+/** Callbacks of the insertion family. */
+typedef struct domel_insertion_family_v2 {
+  uint32_t struct_size;
+  uint32_t reserved;        /**< 0 */
+  domel_insert_fn insert;   /**< required */
+} domel_insertion_family_v2;
+
+/* ------------------------------------------------------------------------ */
+/* Shared views for the controller and fluid_coupler families                */
+/* ------------------------------------------------------------------------ */
+
+/** Read-only cell averages of one level on its hexahedral grid
+ *  (docs/physics.md §5). Cell (ix, iy, iz) has index ix + nx (iy + ny iz).
+ *  Per-cell arrays have n_cells entries; a cell with no particle has
+ *  count 0, mass 0 and zero velocities (its min and max too). */
+typedef struct domel_cell_grid_v1 {
+  uint32_t struct_size;
+  uint32_t nx, ny, nz;        /**< cells per axis */
+  double origin[3];           /**< lower corner of cell (0,0,0)  [m] */
+  double spacing[3];          /**< cell edge lengths  [m] */
+  size_t n_cells;             /**< nx ny nz */
+  const uint32_t* count;      /**< particles whose centre lies in the cell */
+  const double* volume_fraction; /**< solid volume fraction phi  [-] */
+  const double* mass;         /**< particle mass in the cell  [kg] */
+  const double *ux, *uy, *uz; /**< mass-weighted mean velocity  [m/s] */
+  /** smallest and largest particle velocity per component in the cell [m/s] */
+  const double *u_min_x, *u_min_y, *u_min_z;
+  const double *u_max_x, *u_max_y, *u_max_z;
+  /** stress tensor, 6 per cell in the order xx, yy, zz, xy, xz, yz, kinetic
+   *  plus contact part, compression negative  [Pa] */
+  const double* stress;
+} domel_cell_grid_v1;
+
+/** Particle state of one level. Positions, velocities and the rest are
+ *  [in]; fx, fy, fz are [out]: the external force on each particle, ADDED to
+ *  (the host zeroes them before the call and applies them as body forces
+ *  until the next call). */
+typedef struct domel_particles_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  size_t n;
+  const uint64_t* id;         /**< stable particle id */
+  const double *x, *y, *z;    /**< position  [m] */
+  const double *vx, *vy, *vz; /**< velocity  [m/s] */
+  const double* mass;         /**< [kg] */
+  const double* radius;       /**< [m] */
+  const uint32_t* cell;       /**< cell index in the level's grid; UINT32_MAX outside it */
+  double *fx, *fy, *fz;       /**< [out] external force  [N] */
+} domel_particles_v1;
+
+/** One resolution level (a subdomain) as a controller or coupler sees it. */
+typedef struct domel_level_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  const char* name;           /**< subdomain name */
+  double coarse_grain;        /**< coarse-grain ratio alpha  [-] */
+  const domel_cell_grid_v1* cells;
+  domel_particles_v1* particles;
+} domel_level_v1;
+
+/* ------------------------------------------------------------------------ */
+/* Controller family                                                          */
+/* ------------------------------------------------------------------------ */
+
+/** One control interval of a coupling between levels. levels[0] is the
+ *  level the coupling is declared on (e.g. the fine one), levels[1] its
+ *  partner (e.g. the coarse one); level_count is 2 for a coupling of two
+ *  levels. A controller may write forces to the particles of any level. */
+typedef struct domel_control_step_v1 {
+  uint32_t struct_size;
+  uint32_t level_count;
+  double time;                /**< simulated time at the end of the interval  [s] */
+  double interval;            /**< length of the control interval  [s] */
+  domel_level_v1* const* levels;
+} domel_control_step_v1;
+
+/* Called once per control interval, from one thread at a time: a controller
+ * may keep state (an integral term) in its instance. */
+typedef domel_status (*domel_control_fn)(void* instance, domel_control_step_v1* step, char* err,
+                                         size_t err_capacity);
+
+/** Callbacks of the controller family. */
+typedef struct domel_controller_family_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  domel_control_fn control;   /**< required */
+} domel_controller_family_v1;
+
+/* ------------------------------------------------------------------------ */
+/* Fluid-coupler family                                                       */
+/* ------------------------------------------------------------------------ */
+
+/** One coupling exchange: the particle data of a level go to the fluid
+ *  solver, the per-particle fluid force (drag, pressure gradient, ...) comes
+ *  back in particles->fx, fy, fz. cells may be NULL when the level has no
+ *  averaging grid. */
+typedef struct domel_fluid_exchange_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  double time;                /**< simulated time  [s] */
+  double interval;            /**< coupling interval: time since the previous exchange  [s] */
+  domel_level_v1* level;
+} domel_fluid_exchange_v1;
+
+/* Called once per coupling interval, from one thread at a time. */
+typedef domel_status (*domel_fluid_exchange_fn)(void* instance, domel_fluid_exchange_v1* exchange, char* err,
+                                                size_t err_capacity);
+
+/** Callbacks of the fluid_coupler family. */
+typedef struct domel_fluid_coupler_family_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;                /**< 0 */
+  domel_fluid_exchange_fn exchange; /**< required */
+} domel_fluid_coupler_family_v1;
+
+/* ------------------------------------------------------------------------ */
+/* Model and library descriptors                                             */
+/* ------------------------------------------------------------------------ */
+
+typedef domel_status (*domel_create_fn)(const char* params_json, const domel_host_v2* host,
                                         void** out_instance, char* err, size_t err_capacity);
 typedef void (*domel_destroy_fn)(void* instance);
-/* Thread safety (ABI 1.1): the host may call `contact` of ONE instance from
- * several threads at once, each with its own batch. A contact kernel must
- * therefore not modify its instance; per-contact state belongs in history. */
-typedef domel_status (*domel_contact_fn)(void* instance, domel_contact_batch_v1* batch,
-                                         char* err, size_t err_capacity);
-typedef domel_status (*domel_insert_fn)(void* instance, const domel_insert_request_v1* request,
-                                        domel_insert_output_v1* output, char* err,
-                                        size_t err_capacity);
 
-/** One model. `create`, `destroy` and the callback of its kind are required. */
-typedef struct domel_model_v1 {
+/** One model. `create`, `destroy`, `family` and the required callbacks of
+ *  its family's table are required. */
+typedef struct domel_model_v2 {
   uint32_t struct_size;
-  uint32_t kind;                  /**< domel_kind */
+  uint32_t kind;                  /**< domel_kind; selects the type `family` points to */
   const char* name;               /**< scenario keyword, lowercase snake_case, unique per kind */
   const char* version;            /**< model version, "MAJOR.MINOR.PATCH" */
   const char* summary;            /**< one line for `domel plugins` */
   const char* params_schema_json; /**< JSON Schema of its parameters, "x-unit" on each number */
-  uint32_t history_slots;         /**< doubles of per-contact history (contact kinds) */
-  uint32_t flags;                 /**< reserved, 0 */
   domel_create_fn create;
   domel_destroy_fn destroy;
-  domel_contact_fn contact;       /**< contact kinds */
-  domel_insert_fn insert;         /**< DOMEL_KIND_INSERTION */
-} domel_model_v1;
+  /** The family's table: domel_contact_family_v2, domel_insertion_family_v2,
+   *  domel_controller_family_v1 or domel_fluid_coupler_family_v1, by kind.
+   *  Each begins with its struct_size. */
+  const void* family;
+} domel_model_v2;
 
-/** What domel_plugin_entry_v1 returns: a static description of the library. */
-typedef struct domel_library_v1 {
+/** What domel_plugin_entry_v2 returns: a static description of the library. */
+typedef struct domel_library_v2 {
   uint32_t struct_size;
   uint32_t abi_major;          /**< DOMEL_ABI_MAJOR the library was built with */
   uint32_t abi_minor;          /**< DOMEL_ABI_MINOR the library was built with */
   const char* name;            /**< library name, e.g. "domel_contact_std" */
   const char* version;         /**< library version */
   uint32_t model_count;
-  const domel_model_v1* const* models;
-} domel_library_v1;
+  const domel_model_v2* const* models;
+} domel_library_v2;
 
 /** The one exported entry symbol. */
-#define DOMEL_ENTRY_SYMBOL "domel_plugin_entry_v1"
-typedef const domel_library_v1* (*domel_entry_fn)(void);
+#define DOMEL_ENTRY_SYMBOL "domel_plugin_entry_v2"
+typedef const domel_library_v2* (*domel_entry_fn)(void);
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -12,12 +12,21 @@
 //     static constexpr unsigned kHistorySlots = 3;        // optional, default 0
 //     static constexpr const char* kSchema = R"json({ ...JSON Schema... })json";
 //     explicit MyRolling(const domel::sdk::Params& p);      // throw to refuse
-//     void compute(domel_contact_batch_v1& batch) const;   // contact kinds
+//     void compute(domel_contact_batch_v2& batch) const;   // contact kinds
 //   };
 //   DOMEL_PLUGIN_LIBRARY("my_library", "1.0.0", MyRolling /*, more models */)
 //
-// Insertion models implement `void insert(const domel_insert_request_v1&,
-// domel::sdk::Inserted& out)` instead of compute().
+// The callback of each family (abi.h):
+//   contact kinds   void compute(domel_contact_batch_v2&) const;  batch.pair is
+//                   always set: a batch of several material pairs is split
+//                   into runs of one pair before compute() sees it
+//   insertion       void insert(const domel_insert_request_v1&, domel::sdk::Inserted& out);
+//   controller      void control(domel_control_step_v1&);
+//   fluid_coupler   void exchange(domel_fluid_exchange_v1&);
+//
+// Host services: `p.host()` in the constructor is the model's domel::sdk::Host
+// (keep a copy); host.info("...") logs under the model's name and scenario
+// location, host.error("...") reports an error with that context.
 //
 // Nothing here crosses the ABI: exceptions thrown by a model are caught in
 // the generated C callbacks and turned into a status plus message; JSON is
@@ -28,6 +37,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstddef>
 #include <cstring>
 #include <exception>
 #include <stdexcept>
@@ -43,12 +53,39 @@ class ParameterError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The host services of one model instance (abi.h, domel_host_v2). Cheap to
+/// copy; valid while the instance lives. Messages are prefixed by the host
+/// with the model's kind and name, its library and its scenario location.
+class Host {
+ public:
+  Host() = default;
+  explicit Host(const domel_host_v2* h) : h_(h) {}
+  void debug(const std::string& m) const { log(0, m); }
+  void info(const std::string& m) const { log(1, m); }
+  void warn(const std::string& m) const { log(2, m); }
+  /// Report an error with its context; the host logs it and keeps it as the
+  /// instance's last error (used when a callback fails without a message).
+  void error(const std::string& m, domel_status code = DOMEL_ERR_RUNTIME) const {
+    if (h_ != nullptr && h_->struct_size >= offsetof(domel_host_v2, error) + sizeof(h_->error) && h_->error)
+      h_->error(h_->context, code, m.c_str());
+  }
+  void log(int level, const std::string& m) const {
+    if (h_ != nullptr && h_->log) h_->log(h_->context, level, m.c_str());
+  }
+  const domel_host_v2* raw() const { return h_; }
+
+ private:
+  const domel_host_v2* h_ = nullptr;
+};
+
 /// Read-only view of a model's parameters. The host has already validated
 /// them against the model's schema, so the accessors only guard against a
 /// schema and a constructor that disagree.
 class Params {
  public:
-  explicit Params(const nlohmann::json& j) : j_(j) {}
+  explicit Params(const nlohmann::json& j, Host host = Host()) : j_(j), host_(host) {}
+  /// The instance's host services (logging and errors under the model's name).
+  Host host() const { return host_; }
   bool has(const char* key) const { return j_.contains(key); }
   double number(const char* key) const {
     auto it = j_.find(key);
@@ -73,6 +110,7 @@ class Params {
 
  private:
   const nlohmann::json& j_;
+  Host host_;
 };
 
 /// Particles produced by an insertion model (radii already include alpha).
@@ -103,6 +141,41 @@ constexpr bool is_contact_kind(domel_kind k) {
          k == DOMEL_KIND_ROLLING || k == DOMEL_KIND_TWISTING;
 }
 
+/// Calls f(sub) for each run of contacts of one material pair, sub being a
+/// view of the batch's contacts [c0, c0 + m) with sub.pair set (abi.h,
+/// domel_contact_batch_v2::pair). A uniform batch (pair set) is passed as
+/// is: one test per batch, nothing per contact.
+template <class F>
+inline void for_each_pair_run(domel_contact_batch_v2& b, F&& f) {
+  if (b.pair != nullptr || b.n == 0) {
+    f(b);
+    return;
+  }
+  uint32_t c0 = 0;
+  while (c0 < b.n) {
+    const domel_pair_v2* p = b.pair_of[c0];
+    uint32_t c1 = c0 + 1;
+    while (c1 < b.n && b.pair_of[c1] == p) ++c1;
+    domel_contact_batch_v2 sub = b;
+    sub.n = c1 - c0;
+    sub.pair = p;
+    sub.pair_of = b.pair_of + c0;
+    const double** in[] = {&sub.overlap,  &sub.nx,       &sub.ny,     &sub.nz,     &sub.r_eff, &sub.m_eff,
+                           &sub.radius_i, &sub.radius_j, &sub.mass_i, &sub.mass_j, &sub.vn,    &sub.vtx,
+                           &sub.vty,      &sub.vtz,      &sub.wx,     &sub.wy,     &sub.wz};
+    for (auto* q : in)
+      if (*q) *q += c0;
+    double** out[] = {&sub.fn_elastic, &sub.kn, &sub.kn_tangent, &sub.contact_radius, &sub.fn_damping,
+                      &sub.eta_n, &sub.fn, &sub.ftx, &sub.fty, &sub.ftz, &sub.tqx, &sub.tqy, &sub.tqz,
+                      &sub.rolling_stiffness, &sub.rolling_damping};
+    for (auto* q : out)
+      if (*q) *q += c0;
+    if (sub.history) sub.history += static_cast<size_t>(c0) * b.history_stride;
+    f(sub);
+    c0 = c1;
+  }
+}
+
 /// Instance wrapper: the model plus scratch the C callbacks need.
 template <class M>
 struct Instance {
@@ -113,12 +186,12 @@ struct Instance {
 
 template <class M>
 struct Export {
-  static domel_status create(const char* params_json, const domel_host_v1* /*host*/,
+  static domel_status create(const char* params_json, const domel_host_v2* host,
                              void** out, char* err, std::size_t cap) {
     *out = nullptr;
     try {
       const nlohmann::json j = nlohmann::json::parse(params_json ? params_json : "{}");
-      *out = new Instance<M>(Params(j));
+      *out = new Instance<M>(Params(j, Host(host)));
       return DOMEL_OK;
     } catch (const std::exception& e) {
       write_message(err, cap, e.what());
@@ -129,13 +202,14 @@ struct Export {
   }
   static void destroy(void* p) { delete static_cast<Instance<M>*>(p); }
 
-  static domel_status contact(void* self, domel_contact_batch_v1* batch, char* err,
+  static domel_status contact(void* self, domel_contact_batch_v2* batch, char* err,
                               std::size_t cap) {
     if constexpr (is_contact_kind(M::kKind)) {
       try {
         // through a const reference: kernels may run concurrently on one
         // instance (abi.h), so compute() must not modify the model
-        static_cast<const M&>(static_cast<Instance<M>*>(self)->model).compute(*batch);
+        const M& model = static_cast<Instance<M>*>(self)->model;
+        for_each_pair_run(*batch, [&](domel_contact_batch_v2& run) { model.compute(run); });
         return DOMEL_OK;
       } catch (const std::exception& e) {
         write_message(err, cap, e.what());
@@ -181,29 +255,82 @@ struct Export {
     }
   }
 
-  static const domel_model_v1* descriptor() {
-    static const domel_model_v1 d = {
-        sizeof(domel_model_v1),
+  static domel_status control(void* self, domel_control_step_v1* step, char* err, std::size_t cap) {
+    if constexpr (M::kKind == DOMEL_KIND_CONTROLLER) {
+      try {
+        static_cast<Instance<M>*>(self)->model.control(*step);
+        return DOMEL_OK;
+      } catch (const std::exception& e) {
+        write_message(err, cap, e.what());
+      } catch (...) {
+        write_message(err, cap, "unknown exception in controller");
+      }
+      return DOMEL_ERR_RUNTIME;
+    } else {
+      (void)self; (void)step;
+      write_message(err, cap, "not a controller");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
+  static domel_status exchange(void* self, domel_fluid_exchange_v1* ex, char* err, std::size_t cap) {
+    if constexpr (M::kKind == DOMEL_KIND_FLUID_COUPLER) {
+      try {
+        static_cast<Instance<M>*>(self)->model.exchange(*ex);
+        return DOMEL_OK;
+      } catch (const std::exception& e) {
+        write_message(err, cap, e.what());
+      } catch (...) {
+        write_message(err, cap, "unknown exception in fluid coupler");
+      }
+      return DOMEL_ERR_RUNTIME;
+    } else {
+      (void)self; (void)ex;
+      write_message(err, cap, "not a fluid coupler");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
+  /// The family table of M's kind.
+  static const void* family() {
+    if constexpr (is_contact_kind(M::kKind)) {
+      static const domel_contact_family_v2 t = {sizeof(domel_contact_family_v2), history_slots<M>::value,
+                                                &Export::contact};
+      return &t;
+    } else if constexpr (M::kKind == DOMEL_KIND_INSERTION) {
+      static const domel_insertion_family_v2 t = {sizeof(domel_insertion_family_v2), 0u, &Export::insert};
+      return &t;
+    } else if constexpr (M::kKind == DOMEL_KIND_CONTROLLER) {
+      static const domel_controller_family_v1 t = {sizeof(domel_controller_family_v1), 0u, &Export::control};
+      return &t;
+    } else {
+      static_assert(M::kKind == DOMEL_KIND_FLUID_COUPLER, "a model's kKind must be a domel_kind");
+      static const domel_fluid_coupler_family_v1 t = {sizeof(domel_fluid_coupler_family_v1), 0u,
+                                                      &Export::exchange};
+      return &t;
+    }
+  }
+
+  static const domel_model_v2* descriptor() {
+    static const domel_model_v2 d = {
+        sizeof(domel_model_v2),
         static_cast<uint32_t>(M::kKind),
         M::kName,
         M::kVersion,
         M::kSummary,
         M::kSchema,
-        history_slots<M>::value,
-        0u,
         &Export::create,
         &Export::destroy,
-        is_contact_kind(M::kKind) ? &Export::contact : nullptr,
-        M::kKind == DOMEL_KIND_INSERTION ? &Export::insert : nullptr,
+        family(),
     };
     return &d;
   }
 };
 
 template <class... Ms>
-const domel_library_v1* library(const char* name, const char* version) {
-  static const domel_model_v1* const models[] = {Export<Ms>::descriptor()...};
-  static const domel_library_v1 lib = {sizeof(domel_library_v1),
+const domel_library_v2* library(const char* name, const char* version) {
+  static const domel_model_v2* const models[] = {Export<Ms>::descriptor()...};
+  static const domel_library_v2 lib = {sizeof(domel_library_v2),
                                        DOMEL_ABI_MAJOR,
                                        DOMEL_ABI_MINOR,
                                        name,
@@ -218,6 +345,6 @@ const domel_library_v1* library(const char* name, const char* version) {
 
 /// Export a plugin library: its name, its version and the model classes.
 #define DOMEL_PLUGIN_LIBRARY(LIBRARY_NAME, LIBRARY_VERSION, ...)                       \
-  extern "C" DOMEL_EXPORT const domel_library_v1* domel_plugin_entry_v1(void) {         \
+  extern "C" DOMEL_EXPORT const domel_library_v2* domel_plugin_entry_v2(void) {         \
     return ::domel::sdk::detail::library<__VA_ARGS__>(LIBRARY_NAME, LIBRARY_VERSION);   \
   }
