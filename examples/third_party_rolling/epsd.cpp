@@ -3,8 +3,8 @@
 // Rolling slot "epsd": the elastic-plastic spring-dashpot rolling resistance
 // of Ai, Chen, Rotter & Ooi (2011), "Assessment of rolling resistance models
 // in discrete element simulations", Powder Technol. 206, 269-282 ("model C"),
-// as LIGGGHTS computes it (rolling_model_epsd.h; project physics reference
-// /work/shared/docs/physics.md §2.2). A third-party plugin: it is built
+// as LIGGGHTS computes it (rolling_model_epsd.h; docs/physics.md, rolling
+// models, and docs/tutorial-rolling-plugin.md). A third-party plugin: it is built
 // against the INSTALLED domel SDK only (see CMakeLists.txt, README.md and
 // docs/tutorial-rolling-plugin.md, whose code is this file).
 //

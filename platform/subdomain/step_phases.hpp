@@ -33,6 +33,7 @@
 namespace domel::platform {
 
 class Subdomain;
+struct ParticleStore;
 
 enum class Phase : int {
   initial_integrate = 0,
@@ -51,11 +52,14 @@ constexpr const char* kPhaseNames[kPhaseCount] = {
     "initial_integrate", "exchange",         "neighbor",   "ghost_update",    "body_force",
     "contact_force",     "reverse_exchange", "post_force", "final_integrate", "end_of_step"};
 
-/// What a hook sees: the subdomain (its store is complete up to the phase),
-/// the step's index (0 for the first step) and the time the step ends at,
-/// which is the time of its force evaluation.
+/// What a hook sees: the subdomain and its particles as they are at the
+/// phase (`store` is the subdomain's store without the synchronisation and
+/// contact counting of Subdomain::store(), which a hook does not need), the
+/// step's index (0 for the first step) and the time the step ends at, which
+/// is the time of its force evaluation.
 struct StepContext {
   Subdomain& subdomain;
+  ParticleStore& store;
   std::uint64_t step;
   double time;
   double dt;

@@ -298,7 +298,7 @@ void Subdomain::step_fused() {
 void Subdomain::run_hooks(Phase phase) {
   const auto& list = hooks_.at(phase);
   if (list.empty()) return;
-  StepContext ctx{*this, steps_, time_ + dt_, dt_, phase};
+  StepContext ctx{*this, store_, steps_, time_ + dt_, dt_, phase};
   for (const StepHook& h : list) {
     try {
       h.run(ctx);

@@ -10,6 +10,7 @@
 // past a broken library, and loading the same file twice is a no-op.
 #include "core/error.hpp"
 #include "loader/plugin_registry.hpp"
+#include "scenario/scenario.hpp"
 
 #include <domel/sdk/abi.h>
 
@@ -302,6 +303,52 @@ TEST(AbiLoader, KernelFailureBecomesPluginError) {
       EXPECT_CONTAINS(m, "twisting model 'abi_failing_twisting' (library 'abi_failing') at test: contact kernel failed");
       EXPECT_CONTAINS(m, "deliberate failure on a batch of 3 contacts");
     }
+  }
+}
+
+// Guards issue 13 item 7: a kernel that fails in the middle of a run is
+// reported with the subdomain, the step, the simulated time and the ids of
+// the batch's particles (here a sphere that falls onto a floor: the failing
+// twisting model is first called at its first contact, step ~755: a fall of
+// 0.1 d takes sqrt(0.2 d / g) = 7.55 ms at 1e-5 s a step).
+TEST(AbiLoader, KernelFailureDuringARunNamesItsPlace) {
+  PluginRegistry registry;
+  registry.load_directory(DOMEL_BINARY_DIR "/plugins");
+  registry.load(good("failing_kernel"));
+  const double d = 0.0028;
+  const nlohmann::json doc = {
+      {"gravity", {0, 0, -9.81}},
+      {"materials", {{"m", {{"density", 2500}, {"youngs_modulus", 5e6}, {"poisson_ratio", 0.3}}}}},
+      {"interactions", {{{"materials", {"m", "m"}}, {"restitution", 0.5}, {"friction", 0.5}}}},
+      {"walls", {{{"name", "floor"}, {"type", "plane"}, {"material", "m"}, {"point", {0, 0, 0}}, {"normal", {0, 0, 1}}}}},
+      {"subdomains",
+       {{{"name", "column"},
+         {"material", "m"},
+         {"time_step", 1e-5},
+         {"contact", {{"twisting", {{"model", "abi_failing_twisting"}}}}}}}},
+      {"run", {{"duration", 1.0}}},
+      {"output", {{"vtk_interval", 0}, {"probe_interval", 0}}}};
+  // built without particles (the time-step estimate would call the failing
+  // kernel); the sphere is added before set-up, 0.1 d above the floor: its
+  // first contact is a few hundred steps away
+  auto sim = domel::platform::load_scenario(doc, "fall.json", registry);
+  auto& sd = *sim->subdomains[0];
+  auto& s = sd.store();
+  const std::uint64_t id = 42;
+  s.add(id, 0.0, 0.0, 0.6 * d, 0.5 * d, 2500.0);
+  sd.setup();
+  try {
+    for (int k = 0; k < 2000; ++k) sd.step();
+    ADD_FAILURE() << "the failing kernel was never called";
+  } catch (const PluginError& e) {
+    const std::string m = e.what();
+    std::cout << "[run failure] " << m << "\n";
+    EXPECT_CONTAINS(m, "subdomain 'column', step ");
+    EXPECT_CONTAINS(m, ", t = ");
+    EXPECT_CONTAINS(m, "twisting model 'abi_failing_twisting'");
+    EXPECT_CONTAINS(m, "deliberate failure on a batch of 1 contacts");
+    EXPECT_CONTAINS(m, "particle id " + std::to_string(id) + " with wall 'floor'");
+    EXPECT_GT(sd.steps(), 100u);  // during the run, not at set-up
   }
 }
 

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Guards the S–D vs DCT difference at rest (issue 3, acceptance 6(d);
-// mission text §0.1 of shared/docs/physics.md): scenarios/ab/collapse_sd_vs_dct.json,
+// the mission's S–D vs DCT comparison, docs/validation/collapse_sd_vs_dct/report.md):
+// scenarios/ab/collapse_sd_vs_dct.json,
 // a column of ~1900 spheres released on a rough floor at t = 0.2 s, comes to
 // rest by t ~ 0.8 s. Median |omega| (robust against the few free spinners
-// about the contact normal, peers/RESULTS.md §2):
+// about the contact normal, docs/validation/repose.md):
 //  - S–D (sd_critical_angle): keeps decaying once positions are static: at
 //    least tenfold over the last 0.5 s (measured ~200x at dt = 1e-5 s).
 //  - DCT (mu_r = tan theta_c): stalls at a chatter floor that does not decay

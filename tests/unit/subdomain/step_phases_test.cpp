@@ -140,7 +140,7 @@ TEST(StepPhases, PostForceHooksSeeCompleteForces) {
     Subdomain& b = *hooked->subdomains[0];
     std::vector<double> seen_fz, seen_tx;
     b.add_hook(Phase::post_force, {"copy forces", [&](StepContext& c) {
-                                     const auto& s = c.subdomain.store();
+                                     const auto& s = c.store;
                                      seen_fz = s.fz;
                                      seen_tx = s.tx;
                                    }});
@@ -174,7 +174,7 @@ TEST(BodyForces, ExternalForceAndPostForceHookAccelerateAFreeParticle) {
       sd.apply_body_forces(0, 1);  // the forces of the current state include it
     }
     if (way == 2) {
-      sd.add_hook(Phase::post_force, {"push", [f](StepContext& c) { c.subdomain.store().fz[0] += f; }});
+      sd.add_hook(Phase::post_force, {"push", [f](StepContext& c) { c.store.fz[0] += f; }});
       // the forces of the current state include it, as after a complete step
       s.fz[0] += f;
     }
