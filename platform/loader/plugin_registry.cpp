@@ -12,6 +12,7 @@
 #include <cstring>
 #include <mutex>
 #include <sstream>
+#include <type_traits>
 
 namespace domel::platform {
 
@@ -170,7 +171,13 @@ void PluginRegistry::load(const std::filesystem::path& path) {
     require(m.desc.family, "family");
     // The family table: copied zero-filled up to its struct_size; a required
     // callback beyond that size or null is missing, and named.
-    auto table = [&](auto& out, const char* table_name, const char* callback, std::size_t callback_end) {
+    // `Table::*member` is the family's required callback.
+    auto table = [&](auto& out, const char* table_name, const char* callback, auto member) {
+      using Table = std::remove_reference_t<decltype(out)>;
+      const Table probe{};
+      const std::size_t callback_end = static_cast<std::size_t>(reinterpret_cast<const char*>(&(probe.*member)) -
+                                                                reinterpret_cast<const char*>(&probe)) +
+                                       sizeof(probe.*member);
       const uint32_t size = *static_cast<const uint32_t*>(m.desc.family);
       if (size < sizeof(uint32_t))
         refuse(file, who + ": " + what + ": its " + table_name + " has struct_size " + std::to_string(size));
@@ -180,28 +187,17 @@ void PluginRegistry::load(const std::filesystem::path& path) {
         refuse(file, who + ": " + what + " lacks required callback '" + callback + "': its " + table_name +
                          " is " + std::to_string(size) + " bytes, the callback ends at byte " +
                          std::to_string(callback_end));
+      if (out.*member == nullptr)
+        refuse(file, who + ": " + what + " lacks required callback '" + callback + "' (" + table_name + ")");
     };
-    if (is_contact_kind(m.desc.kind)) {
-      table(m.contact, "domel_contact_family_v2", "contact",
-            offsetof(domel_contact_family_v2, contact) + sizeof(m.contact.contact));
-      if (m.contact.contact == nullptr)
-        refuse(file, who + ": " + what + " lacks required callback 'contact' (domel_contact_family_v2)");
-    } else if (m.desc.kind == DOMEL_KIND_INSERTION) {
-      table(m.insertion, "domel_insertion_family_v2", "insert",
-            offsetof(domel_insertion_family_v2, insert) + sizeof(m.insertion.insert));
-      if (m.insertion.insert == nullptr)
-        refuse(file, who + ": " + what + " lacks required callback 'insert' (domel_insertion_family_v2)");
-    } else if (m.desc.kind == DOMEL_KIND_CONTROLLER) {
-      table(m.controller, "domel_controller_family_v1", "control",
-            offsetof(domel_controller_family_v1, control) + sizeof(m.controller.control));
-      if (m.controller.control == nullptr)
-        refuse(file, who + ": " + what + " lacks required callback 'control' (domel_controller_family_v1)");
-    } else if (m.desc.kind == DOMEL_KIND_FLUID_COUPLER) {
-      table(m.fluid_coupler, "domel_fluid_coupler_family_v1", "exchange",
-            offsetof(domel_fluid_coupler_family_v1, exchange) + sizeof(m.fluid_coupler.exchange));
-      if (m.fluid_coupler.exchange == nullptr)
-        refuse(file, who + ": " + what + " lacks required callback 'exchange' (domel_fluid_coupler_family_v1)");
-    }
+    if (is_contact_kind(m.desc.kind))
+      table(m.contact, "domel_contact_family_v2", "contact", &domel_contact_family_v2::contact);
+    else if (m.desc.kind == DOMEL_KIND_INSERTION)
+      table(m.insertion, "domel_insertion_family_v2", "insert", &domel_insertion_family_v2::insert);
+    else if (m.desc.kind == DOMEL_KIND_CONTROLLER)
+      table(m.controller, "domel_controller_family_v1", "control", &domel_controller_family_v1::control);
+    else if (m.desc.kind == DOMEL_KIND_FLUID_COUPLER)
+      table(m.fluid_coupler, "domel_fluid_coupler_family_v1", "exchange", &domel_fluid_coupler_family_v1::exchange);
     m.library_name = lib_name;
     m.version = m.desc.version;
     m.summary = m.desc.summary ? m.desc.summary : "";
