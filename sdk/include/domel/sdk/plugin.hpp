@@ -202,21 +202,30 @@ struct Export {
   }
   static void destroy(void* p) { delete static_cast<Instance<M>*>(p); }
 
+  /// fn()'s status, or DOMEL_ERR_RUNTIME with the exception's message
+  /// ("unknown exception in <what>" for one that is not a std::exception).
+  template <class F>
+  static domel_status guarded(char* err, std::size_t cap, const char* what, F&& fn) {
+    try {
+      return fn();
+    } catch (const std::exception& e) {
+      write_message(err, cap, e.what());
+    } catch (...) {
+      write_message(err, cap, (std::string("unknown exception in ") + what).c_str());
+    }
+    return DOMEL_ERR_RUNTIME;
+  }
+
   static domel_status contact(void* self, domel_contact_batch_v2* batch, char* err,
                               std::size_t cap) {
     if constexpr (is_contact_kind(M::kKind)) {
-      try {
+      return guarded(err, cap, "contact kernel", [&] {
         // through a const reference: kernels may run concurrently on one
         // instance (abi.h), so compute() must not modify the model
         const M& model = static_cast<Instance<M>*>(self)->model;
         for_each_pair_run(*batch, [&](domel_contact_batch_v2& run) { model.compute(run); });
         return DOMEL_OK;
-      } catch (const std::exception& e) {
-        write_message(err, cap, e.what());
-      } catch (...) {
-        write_message(err, cap, "unknown exception in contact kernel");
-      }
-      return DOMEL_ERR_RUNTIME;
+      });
     } else {
       (void)self; (void)batch;
       write_message(err, cap, "not a contact model");
@@ -227,7 +236,7 @@ struct Export {
   static domel_status insert(void* self, const domel_insert_request_v1* req,
                              domel_insert_output_v1* out, char* err, std::size_t cap) {
     if constexpr (M::kKind == DOMEL_KIND_INSERTION) {
-      try {
+      return guarded(err, cap, "insertion", [&] {
         auto* inst = static_cast<Instance<M>*>(self);
         if (inst->last.size() == 0 || out->count != inst->last.size()) {
           inst->last = Inserted{};
@@ -242,12 +251,7 @@ struct Export {
         }
         inst->last = Inserted{};
         return DOMEL_OK;
-      } catch (const std::exception& e) {
-        write_message(err, cap, e.what());
-      } catch (...) {
-        write_message(err, cap, "unknown exception in insertion");
-      }
-      return DOMEL_ERR_RUNTIME;
+      });
     } else {
       (void)self; (void)req; (void)out;
       write_message(err, cap, "not an insertion model");
@@ -257,15 +261,10 @@ struct Export {
 
   static domel_status control(void* self, domel_control_step_v1* step, char* err, std::size_t cap) {
     if constexpr (M::kKind == DOMEL_KIND_CONTROLLER) {
-      try {
+      return guarded(err, cap, "controller", [&] {
         static_cast<Instance<M>*>(self)->model.control(*step);
         return DOMEL_OK;
-      } catch (const std::exception& e) {
-        write_message(err, cap, e.what());
-      } catch (...) {
-        write_message(err, cap, "unknown exception in controller");
-      }
-      return DOMEL_ERR_RUNTIME;
+      });
     } else {
       (void)self; (void)step;
       write_message(err, cap, "not a controller");
@@ -275,15 +274,10 @@ struct Export {
 
   static domel_status exchange(void* self, domel_fluid_exchange_v1* ex, char* err, std::size_t cap) {
     if constexpr (M::kKind == DOMEL_KIND_FLUID_COUPLER) {
-      try {
+      return guarded(err, cap, "fluid coupler", [&] {
         static_cast<Instance<M>*>(self)->model.exchange(*ex);
         return DOMEL_OK;
-      } catch (const std::exception& e) {
-        write_message(err, cap, e.what());
-      } catch (...) {
-        write_message(err, cap, "unknown exception in fluid coupler");
-      }
-      return DOMEL_ERR_RUNTIME;
+      });
     } else {
       (void)self; (void)ex;
       write_message(err, cap, "not a fluid coupler");
