@@ -5,6 +5,7 @@
 // Formulas: docs/physics.md §5.2 and §8; choices: docs/averaging.md.
 #include "averaging/cell_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -30,8 +31,8 @@ void add_outer(double* t, const double l[3], double fx, double fy, double fz, do
 }  // namespace
 
 void CellFields::reset(std::size_t n) {
-  for (std::vector<double>* v : {&count, &count_fixed, &mass, &mobile_mass, &volume_fraction, &vx, &vy,
-                                 &vz, &pressure, &accessible}) {
+  for (std::vector<double>* v : {&count, &count_fixed, &mass, &mobile_mass, &volume_fraction, &vx, &vy, &vz,
+                                 &vmin_x, &vmin_y, &vmin_z, &vmax_x, &vmax_y, &vmax_z, &pressure, &accessible}) {
     v->assign(n, 0.0);
   }
   stress.assign(9 * n, 0.0);
@@ -156,6 +157,13 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
       f.count_fixed[c] += 1;
       continue;
     }
+    const bool first = f.mobile_mass[c] == 0;
+    f.vmin_x[c] = first ? s.vx[k] : std::min(f.vmin_x[c], s.vx[k]);
+    f.vmin_y[c] = first ? s.vy[k] : std::min(f.vmin_y[c], s.vy[k]);
+    f.vmin_z[c] = first ? s.vz[k] : std::min(f.vmin_z[c], s.vz[k]);
+    f.vmax_x[c] = first ? s.vx[k] : std::max(f.vmax_x[c], s.vx[k]);
+    f.vmax_y[c] = first ? s.vy[k] : std::max(f.vmax_y[c], s.vy[k]);
+    f.vmax_z[c] = first ? s.vz[k] : std::max(f.vmax_z[c], s.vz[k]);
     f.mobile_mass[c] += s.mass[k];
     f.vx[c] += s.mass[k] * s.vx[k];
     f.vy[c] += s.mass[k] * s.vy[k];

@@ -60,6 +60,10 @@ struct CellFields {
   std::vector<double> mobile_mass;      ///< [kg], fixed particles excluded (weight of the velocity)
   std::vector<double> volume_fraction;  ///< sum V_i / (V_c w_c), fixed particles included
   std::vector<double> vx, vy, vz;       ///< Favre velocity of the mobile particles [m/s] (0 if none)
+  /// Smallest and largest velocity component of the mobile particles in the
+  /// cell [m/s] (0 if none; the controllers' velocity limit, physics.md
+  /// §5.3). Only latest() has them; a mean over samples leaves them 0.
+  std::vector<double> vmin_x, vmin_y, vmin_z, vmax_x, vmax_y, vmax_z;
   std::vector<double> pressure;         ///< tr(stress)/3 [Pa], > 0 in compression
   std::vector<double> accessible;       ///< w_c in [0, 1]
   std::vector<double> stress;           ///< 9 per cell [Pa], kinetic + contact, > 0 in compression (physics.md §8)
