@@ -487,7 +487,16 @@ std::vector<Diagnostic> validate_scenario_file(const std::filesystem::path& file
   std::vector<Diagnostic> diags;
   json doc = read_json_file(file, diags);
   if (!diags.empty()) return diags;
-  return validate_document(doc, file, registry);
+  diags = validate_document(doc, file, registry);
+  if (!diags.empty()) return diags;
+  // What only the build can check (time steps, grids against the particle
+  // sizes, couplings between levels) is part of validation too.
+  try {
+    build(doc, file, registry);
+  } catch (const ConfigError& e) {
+    return e.diagnostics();
+  }
+  return diags;
 }
 
 std::unique_ptr<Simulation> load_scenario(const nlohmann::json& doc, const std::filesystem::path& file,
