@@ -15,6 +15,10 @@ double macro_step_of(const std::vector<std::unique_ptr<Subdomain>>& subdomains) 
   return dt;
 }
 
+int substeps_of(double macro, double dt) {
+  return std::max(1, static_cast<int>(std::ceil(macro / dt - kTimeTolerance)));
+}
+
 Interval::Interval(double period, double first, double macro_step)
     : period_(period), first_(first), tolerance_(kTimeTolerance * macro_step) {
   if (period_ > 0) next_ = first_;

@@ -34,6 +34,10 @@ inline constexpr double kTimeTolerance = 1e-9;
 /// The macro step of a set of subdomains: the largest time step.
 double macro_step_of(const std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
+/// Sub-steps of a subdomain of time step dt within a macro step: rounded up,
+/// so that no step grows (the subdomain then steps with macro / n).
+int substeps_of(double macro, double dt);
+
 /// A periodic action in simulated time: due at first, first + period,
 /// first + 2 period, ... A default-constructed Interval (or period <= 0) is
 /// never due.
