@@ -8,6 +8,7 @@
 // default is read from the document without a fallback here; a key without
 // one is optional and tested with contains(). Every problem becomes a
 // Diagnostic; build() throws them all at once, before anything is written.
+#include "coupling/coupling.hpp"
 #include "geometry/region.hpp"
 #include "geometry/triangle_mesh.hpp"  // MeshError
 #include "io/particle_state.hpp"
@@ -19,6 +20,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -38,6 +40,11 @@ struct Build {
   std::map<std::string, std::size_t> mat_index;
   std::map<std::pair<std::string, std::string>, PairCoefficients> coeffs;
   std::uint64_t next_id = 1;  ///< id of the next particle made
+  /// Smallest and largest parcel radius of each subdomain built so far
+  /// (present particles and pours; a coupled fine level: its parent's scaled).
+  std::map<std::string, std::array<double, 2>> radii;
+  /// fine subdomain -> (coarse subdomain, coupling index) from /couplings
+  std::map<std::string, std::pair<std::string, std::size_t>> parent;
 };
 
 void build_materials(Build& b) {
@@ -330,18 +337,53 @@ void build_subdomain(Build& b, std::size_t k) {
   std::vector<double> pour_radii;
   build_pours(b, *sub, sd, base, density, pour_radii);
   if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
+  // The fine level of a coupling starts empty: its particles will be its
+  // parent's parcels at its own ratio, which set its skin and time step.
+  if (auto it = b.parent.find(sd_name); it != b.parent.end()) {
+    const auto pr = b.radii.find(it->second.first);
+    if (pr == b.radii.end()) {
+      b.ck.add(idx("/couplings", it->second.second) + "/coarse",
+               "the coarse subdomain '" + it->second.first + "' must come before its fine subdomain '" + sd_name +
+                   "' in /subdomains (the fine level's particle size follows from the coarse one's)");
+      return;
+    }
+    double alpha_c = 1;
+    for (const auto& other : b.doc["subdomains"])
+      if (other["name"] == it->second.first) alpha_c = other["coarse_grain"].get<double>();
+    for (double r : pr->second)
+      if (r > 0) pour_radii.push_back(r * alpha / alpha_c);
+  }
 
   // neighbour skin: fraction of the largest diameter
   double rmax = 0;
   for (double r : sub->store().radius) rmax = std::max(rmax, r);
   for (double r : pour_radii) rmax = std::max(rmax, r);
   sub->set_skin(sd["skin"].get<double>() * 2.0 * (rmax > 0 ? rmax : 1e-3));
+  {
+    double rmin = rmax;
+    for (double r : sub->store().radius) rmin = std::min(rmin, r);
+    for (double r : pour_radii) rmin = std::min(rmin, r);
+    b.radii[sd_name] = {rmin, rmax};
+  }
   sub->set_reorder_every(sd["reorder_every"].get<std::size_t>());
 
   TimeStepReport rep;
   if (!set_time_step(b, *sub, sd, base, pour_radii, density, rep)) return;
   b.sim.time_steps.push_back(rep);
   b.sim.subdomains.push_back(std::move(sub));
+}
+
+/// The index of a subdomain named at `pointer`; an unknown name is reported
+/// (with the nearest name) and gives kAllSubdomains.
+std::size_t subdomain_index(Build& b, const json& name, const std::string& pointer) {
+  const std::string want = name.get<std::string>();
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < b.sim.subdomains.size(); ++k) {
+    if (b.sim.subdomains[k]->name() == want) return k;
+    names.push_back(b.sim.subdomains[k]->name());
+  }
+  b.ck.add(pointer, "unknown subdomain '" + want + "'", suggest(want, names));
+  return kAllSubdomains;
 }
 
 /// Deletion regions, mass-flow planes and the run's deletion interval; the
@@ -351,9 +393,12 @@ void build_particle_flow(Build& b) {
   flow.next_id = b.next_id;
   flow.deletion_interval = b.doc["run"]["deletion_interval"].get<double>();
   if (b.doc.contains("deletion_regions"))
-    for (const auto& d : b.doc["deletion_regions"]) {
+    for (std::size_t i = 0; i < b.doc["deletion_regions"].size(); ++i) {
+      const json& d = b.doc["deletion_regions"][i];
       DeletionRegion dr;
       dr.name = d["name"].get<std::string>();
+      if (d.contains("subdomain"))
+        dr.subdomain = subdomain_index(b, d["subdomain"], idx("/deletion_regions", i) + "/subdomain");
       dr.region = make_region(d["region"]);
       if (d.contains("rate_window"))
         for (int a = 0; a < 2; ++a) dr.rate_window[a] = d["rate_window"][a].get<double>();
@@ -361,9 +406,12 @@ void build_particle_flow(Build& b) {
     }
   const json& out = b.doc["output"];
   if (out.contains("mass_flow"))
-    for (const auto& d : out["mass_flow"]) {
+    for (std::size_t i = 0; i < out["mass_flow"].size(); ++i) {
+      const json& d = out["mass_flow"][i];
       MassFlowPlane pl;
       pl.name = d["name"].get<std::string>();
+      if (d.contains("subdomain"))
+        pl.subdomain = subdomain_index(b, d["subdomain"], idx("/output/mass_flow", i) + "/subdomain");
       double len = 0;
       for (int a = 0; a < 3; ++a) {
         pl.p[a] = d["point"][a].get<double>();
@@ -376,6 +424,324 @@ void build_particle_flow(Build& b) {
       flow.planes.push_back(pl);
     }
   flow.register_hooks(b.sim.hooks);
+}
+
+/// The parent map of /couplings (fine -> coarse), read before the subdomains
+/// are built: a coupled fine level takes its particle size from its parent.
+void scan_couplings(Build& b) {
+  if (!b.doc.contains("couplings")) return;
+  const json& cs = b.doc["couplings"];
+  for (std::size_t c = 0; c < cs.size(); ++c) {
+    const std::string fine = cs[c]["fine"].get<std::string>();
+    if (b.parent.count(fine) != 0) {
+      b.ck.add(idx("/couplings", c) + "/fine", "subdomain '" + fine + "' is already the fine level of " +
+                                                   idx("/couplings", b.parent[fine].second) +
+                                                   "; a level has one parent (nest a third level under it instead)");
+      continue;
+    }
+    b.parent[fine] = {cs[c]["coarse"].get<std::string>(), c};
+  }
+}
+
+/// Bounding box of what bounds a top-level domain: the finite walls, the
+/// pour, insertion and deletion regions. False when nothing is finite.
+bool domain_bounds(Build& b, double lo[3], double hi[3]) {
+  bool any = false;
+  auto grow = [&](const double a[3], const double z[3]) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = any ? std::min(lo[k], a[k]) : a[k];
+      hi[k] = any ? std::max(hi[k], z[k]) : z[k];
+    }
+    any = true;
+  };
+  auto grow_region = [&](const domel_region_v1& r) {
+    if (r.shape == 1) return grow(r.lo, r.hi);
+    double a[3], z[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = k == static_cast<int>(r.axis) ? r.lo[k] : r.center[k] - r.radius;
+      z[k] = k == static_cast<int>(r.axis) ? r.hi[k] : r.center[k] + r.radius;
+    }
+    grow(a, z);
+  };
+  for (const auto& w : b.sim.walls) {
+    double a[3], z[3];
+    if (w.shape == WallPrimitive::Shape::cylinder_inside || w.shape == WallPrimitive::Shape::cone_inside) {
+      const double r = std::max(w.radius, w.radius_hi);
+      for (int k = 0; k < 3; ++k) {
+        a[k] = k == w.axis ? w.lo : w.c[k] - r;
+        z[k] = k == w.axis ? w.hi : w.c[k] + r;
+      }
+      grow(a, z);
+    } else if (w.shape == WallPrimitive::Shape::mesh && w.verts.size() >= 3) {
+      for (int k = 0; k < 3; ++k) a[k] = z[k] = w.verts[k];
+      for (std::size_t v = 0; v + 2 < w.verts.size(); v += 3)
+        for (int k = 0; k < 3; ++k) a[k] = std::min(a[k], w.verts[v + k]), z[k] = std::max(z[k], w.verts[v + k]);
+      grow(a, z);
+    }
+  }
+  if (b.doc.contains("deletion_regions"))
+    for (const auto& d : b.doc["deletion_regions"]) grow_region(make_region(d["region"]));
+  for (const auto& p : b.sim.flow.pours) grow_region(p.region);
+  for (const auto& sd : b.doc["subdomains"])
+    if (sd.contains("insert"))
+      for (const auto& ins : sd["insert"])
+        if (ins.contains("region")) grow_region(make_region(ins["region"]));
+  return any;
+}
+
+/// /couplings: levels, region and cells, faces, timing, controllers.
+void build_couplings(Build& b) {
+  if (!b.doc.contains("couplings")) return;
+  const json& cs = b.doc["couplings"];
+  Simulation& sim = b.sim;
+  const double macro = sim.macro_step();
+  std::vector<std::string> names;
+  for (const auto& sd : sim.subdomains) names.push_back(sd->name());
+  std::vector<CouplingSpec> specs;
+  std::vector<int> requested;  // control_steps of each
+  std::vector<const json*> blocks;
+  for (std::size_t c = 0; c < cs.size(); ++c) {
+    const json& cj = cs[c];
+    const std::string base = idx("/couplings", c);
+    const std::size_t before = b.ck.diags.size();
+    CouplingSpec s;
+    s.name = cj["name"].get<std::string>();
+    s.where = base;
+    for (std::size_t h = 0; h < c; ++h)
+      if (cs[h]["name"] == cj["name"]) b.ck.add(base + "/name", "duplicate coupling name '" + s.name + "'");
+    if (s.name.find('/') != std::string::npos) b.ck.add(base + "/name", "a coupling name names files: no '/'");
+    s.coarse = subdomain_index(b, cj["coarse"], base + "/coarse");
+    s.fine = subdomain_index(b, cj["fine"], base + "/fine");
+    if (b.ck.diags.size() > before) continue;
+    if (b.parent.at(names[s.fine]).second != c) continue;  // a second parent, refused by scan_couplings
+    if (s.coarse == s.fine) {
+      b.ck.add(base + "/fine", "subdomain '" + names[s.fine] + "' is coupled to itself",
+               "a coupling joins a coarse subdomain and a finer one");
+      continue;
+    }
+    Subdomain& coarse = *sim.subdomains[s.coarse];
+    Subdomain& fine = *sim.subdomains[s.fine];
+    if (fine.coarse_grain() >= coarse.coarse_grain()) {
+      b.ck.add(base + "/fine", "expected a fine level with a smaller coarse-grain ratio than the coarse level's " +
+                                   fmt_num(coarse.coarse_grain()) + ", found '" + names[s.fine] + "' at " +
+                                   fmt_num(fine.coarse_grain()));
+      continue;
+    }
+    // a cycle: the coarse level descends from the fine one
+    for (std::string up = names[s.coarse]; b.parent.count(up) != 0;) {
+      up = b.parent[up].first;
+      if (up == names[s.fine]) {
+        b.ck.add(base + "/coarse", "the couplings form a loop: '" + names[s.coarse] + "' is itself a finer level of '" +
+                                       names[s.fine] + "'");
+        break;
+      }
+      if (up == names[s.coarse]) break;
+    }
+    if (b.ck.diags.size() > before) continue;
+    // region and cells
+    const json& rj = cj["region"];
+    const double d_coarse = 2 * b.radii.at(names[s.coarse])[1];
+    s.grid.name = s.name;
+    bool box = true;
+    for (int a = 0; a < 3; ++a) {
+      s.grid.lo[a] = rj["min"][a].get<double>();
+      s.grid.hi[a] = rj["max"][a].get<double>();
+      s.grid.cells[a] = rj["cells"][a].get<int>();
+      if (s.grid.hi[a] <= s.grid.lo[a]) {
+        box = false;
+        b.ck.add(base + "/region/max/" + std::to_string(a), "expected max > min along " + std::string(1, "xyz"[a]) +
+                                                                ", found max " + fmt_num(s.grid.hi[a]) + " <= min " +
+                                                                fmt_num(s.grid.lo[a]));
+        continue;
+      }
+      const double edge = (s.grid.hi[a] - s.grid.lo[a]) / s.grid.cells[a];
+      if (edge < 2 * d_coarse * (1 - 1e-9))
+        b.ck.add(base + "/region/cells/" + std::to_string(a),
+                 "expected cells of at least 2 coarse parcel diameters (" + fmt_num(2 * d_coarse) + " m) along " +
+                     std::string(1, "xyz"[a]) + ", found " + fmt_num(edge) + " m",
+                 "use at most " + std::to_string(std::max(1, static_cast<int>((s.grid.hi[a] - s.grid.lo[a]) /
+                                                                               (2 * d_coarse)))) +
+                     " cells along " + std::string(1, "xyz"[a]));
+    }
+    if (!box) continue;
+    // inside the coarse level's domain
+    if (auto it = b.parent.find(names[s.coarse]); it != b.parent.end()) {
+      const json& pr = cs[it->second.second]["region"];
+      for (int a = 0; a < 3; ++a)
+        if (s.grid.lo[a] < pr["min"][a].get<double>() - 1e-12 || s.grid.hi[a] > pr["max"][a].get<double>() + 1e-12) {
+          b.ck.add(base + "/region", "the fine region lies outside the coarse level's domain: '" + names[s.coarse] +
+                                         "' lives only in the region of " + idx("/couplings", it->second.second) +
+                                         ", and this region leaves it along " + std::string(1, "xyz"[a]));
+          break;
+        }
+    } else {
+      double lo[3], hi[3];
+      if (domain_bounds(b, lo, hi))
+        for (int a = 0; a < 3; ++a)
+          if (s.grid.lo[a] < lo[a] - 1e-12 || s.grid.hi[a] > hi[a] + 1e-12) {
+            b.ck.add(base + "/region", "the fine region lies outside the coarse level's domain along " +
+                                           std::string(1, "xyz"[a]) + ": [" + fmt_num(s.grid.lo[a]) + ", " +
+                                           fmt_num(s.grid.hi[a]) + "] m against [" + fmt_num(lo[a]) + ", " +
+                                           fmt_num(hi[a]) + "] m (the walls, pour, insertion and deletion regions)");
+            break;
+          }
+    }
+    // two fine regions that overlap (a nested region lies inside its parent's, which is fine)
+    for (std::size_t h = 0; h < specs.size(); ++h) {
+      const CouplingSpec& o = specs[h];
+      bool nested = false;
+      for (std::string up = names[s.fine]; b.parent.count(up) != 0 && !nested;) {
+        up = b.parent[up].first;
+        nested = up == names[o.fine];
+        if (up == names[s.fine]) break;
+      }
+      for (std::string up = names[o.fine]; b.parent.count(up) != 0 && !nested;) {
+        up = b.parent[up].first;
+        nested = up == names[s.fine];
+        if (up == names[o.fine]) break;
+      }
+      bool overlap = true;
+      for (int a = 0; a < 3; ++a) overlap = overlap && s.grid.lo[a] < o.grid.hi[a] && o.grid.lo[a] < s.grid.hi[a];
+      if (overlap && !nested)
+        b.ck.add(base + "/region", "this fine region overlaps the one of " + o.where +
+                                       "; fine regions side by side must not overlap (nest one inside the other's "
+                                       "level instead)");
+    }
+    // faces
+    for (const auto& f : cj["inflow_faces"]) s.inflow[face_from_name(f.get<std::string>())] = true;
+    s.shell_depth = cj.contains("shell_depth") ? cj["shell_depth"].get<double>() : 2 * d_coarse;
+    for (int face = 0; face < kFaces; ++face)
+      if (s.inflow[face] && s.shell_depth > s.grid.hi[face / 2] - s.grid.lo[face / 2])
+        b.ck.add(base + (cj.contains("shell_depth") ? "/shell_depth" : "/region"),
+                 "the insertion shell (" + fmt_num(s.shell_depth) + " m) is deeper than the region along " +
+                     std::string(1, "xyz"[face / 2]));
+    s.fill_target = cj["fill_target"].get<double>();
+    s.attempts = cj["insertion_attempts"].get<int>();
+    s.grid_interval = cj["grid_interval"].get<double>();
+    s.fine_density = sim.materials[fine.material()].density;
+    s.alpha_ratio = fine.coarse_grain() / coarse.coarse_grain();
+    // one seed per coupling: the run's seed and the coupling's index mixed as the pours' seeds are
+    s.seed = sim.seed * 6364136223846793005ull + (c + 1) * 1442695040888963407ull;
+    requested.push_back(cj["control_steps"].get<int>());
+    specs.push_back(std::move(s));
+    blocks.push_back(&cj);
+  }
+  if (specs.size() != cs.size()) return;
+  // One control clock for every coupling (several couplings add their forces
+  // into the same level): the most frequent request, in whole macro steps.
+  std::uint64_t control_macro = std::numeric_limits<std::uint64_t>::max();
+  for (std::size_t c = 0; c < specs.size(); ++c) {
+    const int n_f = substeps_of(macro, sim.subdomains[specs[c].fine]->time_step());
+    control_macro = std::min<std::uint64_t>(control_macro, (requested[c] + n_f - 1) / n_f);
+  }
+  sim.control_macro = control_macro;
+  for (std::size_t c = 0; c < specs.size(); ++c) {
+    CouplingSpec& s = specs[c];
+    const json& cj = *blocks[c];
+    const std::string base = s.where;
+    const int n_f = substeps_of(macro, sim.subdomains[s.fine]->time_step());
+    const int n_c = substeps_of(macro, sim.subdomains[s.coarse]->time_step());
+    s.control_macro = control_macro;
+    s.fine_steps = static_cast<int>(control_macro) * n_f;
+    s.coarse_steps = static_cast<int>(control_macro) * n_c;
+    if (s.fine_steps != requested[c])
+      spdlog::info("{}: control interval {} fine steps (asked {}): {} macro step(s) of {:.4g} s, the coarsest level's "
+                   "step, so that every exchange falls on a step of every level",
+                   base, s.fine_steps, requested[c], control_macro, macro);
+    const int tmax = cj["transfer_max_steps"].get<int>();
+    s.transfer_controls = std::max<std::uint64_t>(1, (tmax + s.fine_steps - 1) / s.fine_steps);
+    const double dt_f = macro / n_f, dt_c = macro / n_c;
+    const std::size_t n_cells = static_cast<std::size_t>(s.grid.cells[0]) * s.grid.cells[1] * s.grid.cells[2];
+    auto controller = [&](const char* key, ControllerSetup& setup, json params) {
+      const json& blk = cj[key];
+      setup.enabled = blk["enabled"].get<bool>();
+      if (!setup.enabled) return;
+      const std::string model = blk["model"].get<std::string>();
+      const RegisteredModel* m = b.registry.find(DOMEL_KIND_CONTROLLER, model);
+      if (m == nullptr) {
+        b.ck.add(base + "/" + key + "/model", "unknown controller model '" + model + "'",
+                 suggest(model, b.registry.names(DOMEL_KIND_CONTROLLER)));
+        setup.enabled = false;
+        return;
+      }
+      for (const auto& c : params["cells"])
+        if (c.get<std::size_t>() >= n_cells)
+          b.ck.add(base + "/" + key + "/cells", "expected cell indices below " + std::to_string(n_cells) +
+                                                    " (the region's cells), found " + std::to_string(c.get<std::size_t>()));
+      try {
+        setup.model = std::make_shared<ModelInstance>(*m, params, base + "/" + key);
+        setup.params = params;
+      } catch (const PluginError& e) {
+        b.ck.add(base + "/" + key, e.what());
+        setup.enabled = false;
+      }
+    };
+    // stress control: default cells touch an inflow face; direction: the inward normals
+    {
+      const json& blk = cj["stress_control"];
+      json cells = json::array(), dirs = json::array();
+      if (blk.contains("cells")) {
+        cells = blk["cells"];
+        if (blk.contains("directions")) dirs = blk["directions"];
+        if (dirs.size() != cells.size())
+          b.ck.add(base + "/stress_control/directions",
+                   "expected one direction per controlled cell (" + std::to_string(cells.size()) + "), found " +
+                       std::to_string(dirs.size()));
+      } else {
+        for (int iz = 0; iz < s.grid.cells[2]; ++iz)
+          for (int iy = 0; iy < s.grid.cells[1]; ++iy)
+            for (int ix = 0; ix < s.grid.cells[0]; ++ix) {
+              const int i3[3] = {ix, iy, iz};
+              int dir[3] = {0, 0, 0};
+              bool touches = false;
+              for (int face = 0; face < kFaces; ++face) {
+                const int a = face / 2;
+                const bool at = face % 2 == 0 ? i3[a] == 0 : i3[a] == s.grid.cells[a] - 1;
+                if (!s.inflow[face] || !at) continue;
+                touches = true;
+                dir[a] += face % 2 == 0 ? 1 : -1;  // inward: away from the face
+              }
+              if (!touches) continue;
+              cells.push_back(ix + s.grid.cells[0] * (iy + s.grid.cells[1] * iz));
+              dirs.push_back({dir[0], dir[1], dir[2]});
+            }
+      }
+      for (std::size_t k = 0; k < dirs.size(); ++k)
+        for (int a = 0; a < 3; ++a) {
+          const double v = dirs[k][a].get<double>();
+          if (v != -1 && v != 0 && v != 1)
+            b.ck.add(base + "/stress_control/directions/" + std::to_string(k) + "/" + std::to_string(a),
+                     "expected -1, 0 or 1, found " + fmt_num(v));
+        }
+      json p = {{"cells", cells},
+                {"directions", dirs},
+                {"kp", blk.contains("kp") ? blk["kp"].get<double>() : 1.0 / s.fine_steps},
+                {"ki", blk.contains("ki") ? blk["ki"].get<double>() : 1.0 / (s.fine_steps * dt_f)},
+                {"layer_diameters", blk["layer_diameters"]},
+                {"fade_fraction", blk["fade_fraction"]},
+                {"velocity_limit", blk["velocity_limit"]}};
+      controller("stress_control", s.stress, p);
+    }
+    {
+      const json& blk = cj["velocity_control"];
+      json cells = json::array();
+      if (blk.contains("cells")) cells = blk["cells"];
+      else
+        for (std::size_t k = 0; k < n_cells; ++k) cells.push_back(k);
+      json p = {{"cells", cells},
+                {"kp", blk.contains("kp") ? blk["kp"].get<double>() : 1.0 / s.coarse_steps},
+                {"ki", blk["ki"]},
+                {"time_step", dt_c},
+                {"mass_flow_correction", json::array()},
+                {"velocity_limit", blk["velocity_limit"]}};
+      for (std::size_t k = 0; k < cells.size(); ++k) p["mass_flow_correction"].push_back(blk["mass_flow_correction"]);
+      controller("velocity_control", s.velocity, p);
+    }
+    sim.subdomains[s.fine]->store().enable_external_force();
+    sim.subdomains[s.coarse]->store().enable_external_force();
+    sim.couplings.push_back(std::make_unique<Coupling>(std::move(s)));
+  }
+  sim.flow.expect_external();
 }
 
 /// output.grids: the cell grids' specifications (their write interval, when
@@ -472,7 +838,9 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_materials(b);
   build_walls(b);
   build_run(b);
+  scan_couplings(b);
   for (std::size_t k = 0; k < doc["subdomains"].size(); ++k) build_subdomain(b, k);
+  if (b.sim.subdomains.size() == doc["subdomains"].size()) build_couplings(b);
   build_particle_flow(b);
   build_grids(b);
   if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);

@@ -136,10 +136,23 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   }
 }
 
+void ParticleFlow::count_inserted(std::size_t k, double mass) {
+  accounts_.at(k).inserted += mass_units(mass);
+  ++accounts_[k].n_inserted;
+}
+
+void ParticleFlow::count_removed(std::size_t k, std::uint64_t id, double mass) {
+  accounts_.at(k).removed += mass_units(mass);
+  ++accounts_[k].n_removed;
+  for (auto& pl : planes)
+    if (k < pl.side.size()) pl.side[k].erase(id);
+}
+
 void ParticleFlow::check_planes(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
   for (auto& pl : planes) {
     if (pl.side.size() != subdomains.size()) pl.side.assign(subdomains.size(), {});
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
+      if (pl.subdomain != kAllSubdomains && pl.subdomain != k) continue;
       const ParticleStore& s = subdomains[k]->store();
       auto& side = pl.side[k];
       for (std::size_t q = 0; q < s.size(); ++q) {
@@ -164,7 +177,8 @@ void ParticleFlow::delete_particles(std::vector<std::unique_ptr<Subdomain>>& sub
     bool any = false;
     for (std::size_t q = 0; q < s.size(); ++q) {
       for (auto& d : deletions) {
-        if (!region_contains(d.region, s.x[q], s.y[q], s.z[q])) continue;
+        if ((d.subdomain != kAllSubdomains && d.subdomain != k) || !region_contains(d.region, s.x[q], s.y[q], s.z[q]))
+          continue;
         mark[q] = 1;
         any = true;
         ++d.removed;

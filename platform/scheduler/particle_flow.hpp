@@ -86,8 +86,12 @@ struct Pour {
   bool warned = false;
 };
 
+/// Counts every subdomain's particles.
+inline constexpr std::size_t kAllSubdomains = static_cast<std::size_t>(-1);
+
 struct DeletionRegion {
   std::string name;
+  std::size_t subdomain = kAllSubdomains;  ///< the only subdomain it removes from, or all
   domel_region_v1 region{};
   double rate_window[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
   std::uint64_t removed = 0;
@@ -97,6 +101,7 @@ struct DeletionRegion {
 
 struct MassFlowPlane {
   std::string name;
+  std::size_t subdomain = kAllSubdomains;  ///< the only subdomain it counts, or all
   double p[3] = {0, 0, 0};
   double n[3] = {0, 0, 1};
   double rate_window[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
@@ -114,7 +119,16 @@ class ParticleFlow {
   double deletion_interval = 0;  ///< [s] between deletion (and plane) checks: run.deletion_interval
   std::uint64_t next_id = 1;     ///< id of the next inserted particle
 
-  bool empty() const { return pours.empty() && deletions.empty() && planes.empty(); }
+  bool empty() const { return pours.empty() && deletions.empty() && planes.empty() && !external_; }
+
+  /// Particles that something else (a coupling between levels) adds to or
+  /// removes from subdomain k between steps: they enter the balance like a
+  /// pour's or a deletion region's, and a removed one leaves the planes' books.
+  void count_inserted(std::size_t k, double mass);
+  void count_removed(std::size_t k, std::uint64_t id, double mass);
+  /// Something else adds and removes particles: the balance is kept (and
+  /// reported) even without pours, deletions or planes.
+  void expect_external() { external_ = true; }
 
   /// Before the first step: every particle present counts as inserted; the
   /// pours' and checks' intervals start (their tolerance from the
@@ -141,6 +155,7 @@ class ParticleFlow {
   void delete_particles(std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
   std::vector<MassAccount> accounts_;
+  bool external_ = false;
   Interval checks_;  ///< deletion (and plane) checks, every deletion_interval from deletion_interval on
   double last_row_t_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> last_row_;

@@ -13,6 +13,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cctype>
 #include <cmath>
@@ -74,7 +75,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const double macro = macro_step();
   std::vector<int> substeps;
   for (auto& sd : subdomains) {
-    const int n = std::max(1, static_cast<int>(std::ceil(macro / sd->time_step() - kTimeTolerance)));
+    const int n = substeps_of(macro, sd->time_step());
     if (std::fabs(macro / n - sd->time_step()) > 1e-12 * macro) {
       spdlog::info("subdomain '{}': time step adjusted from {:.6g} s to {:.6g} s = macro step / {}", sd->name(),
                    sd->time_step(), macro / n, n);
@@ -108,19 +109,46 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                                                  : nullptr);
     grid_files.emplace_back(g.spec.write_interval, g.spec.write_interval, macro);
   }
+  // Every grid that samples a subdomain: the output grids and both levels of each coupling.
+  std::vector<std::pair<CellGrid*, std::size_t>> samplers;
+  for (std::size_t g = 0; g < grids.size(); ++g) samplers.emplace_back(grids[g].get(), grid_setups[g].subdomain);
+  for (auto& c : couplings) {
+    c->start(subdomains, walls, out);
+    samplers.emplace_back(&c->fine_grid(), c->spec().fine);
+    samplers.emplace_back(&c->coarse_grid(), c->spec().coarse);
+  }
   auto step_subdomain = [&](std::size_t k) {
     Subdomain& sd = *subdomains[k];
     bool record = false;
-    for (std::size_t g = 0; g < grids.size(); ++g)
-      record = record || (grid_setups[g].subdomain == k && grids[g]->due(sd.steps() + 1));
+    for (const auto& [grid, sub] : samplers) record = record || (sub == k && grid->due(sd.steps() + 1));
     sd.set_record_contacts(record);
     sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
     if (!record) return;
     const auto records = sd.contact_records();
-    for (std::size_t g = 0; g < grids.size(); ++g)
-      if (grid_setups[g].subdomain == k && grids[g]->due(sd.steps())) grids[g]->sample(sd.store(), records, sd.time());
+    for (const auto& [grid, sub] : samplers)
+      if (sub == k && grid->due(sd.steps())) grid->sample(sd.store(), records, sd.time());
     sd.set_record_contacts(false);
   };
+  // The couplings' exchange, after the flow's own before-step work: at every
+  // control_macro-th macro step all levels stand at the same time t, the
+  // external forces are rebuilt from zero by every coupling's controllers.
+  MacroHooks run_hooks = hooks;
+  if (!couplings.empty()) {
+    std::vector<std::size_t> levels;
+    for (const auto& c : couplings)
+      for (std::size_t k : {c->spec().fine, c->spec().coarse})
+        if (std::find(levels.begin(), levels.end(), k) == levels.end()) levels.push_back(k);
+    run_hooks.before.push_back([this, levels](const MacroStep& step) {
+      if (step.index == 0 || step.index % control_macro != 0) return;
+      for (std::size_t k : levels) {
+        ParticleStore& s = subdomains[k]->store();
+        std::fill(s.ext_fx.begin(), s.ext_fx.end(), 0.0);
+        std::fill(s.ext_fy.begin(), s.ext_fy.end(), 0.0);
+        std::fill(s.ext_fz.begin(), s.ext_fz.end(), 0.0);
+      }
+      for (auto& c : couplings) c->exchange(step.t, subdomains, walls, flow);
+    });
+  }
   // Walls that appear or disappear (an outlet plug) change the accessible
   // volume: recompute it when the set of active walls changes.
   std::vector<char> wall_active;
@@ -132,8 +160,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       changed = changed || now != wall_active[w];
       wall_active[w] = now;
     }
-    if (changed)
-      for (auto& g : grids) g->set_accessible(walls, t);
+    if (!changed) return;
+    for (auto& g : grids) g->set_accessible(walls, t);
+    for (auto& c : couplings) {
+      c->fine_grid().set_accessible(walls, t);
+      c->coarse_grid().set_accessible(walls, t);
+    }
   };
   auto write_grids = [&](double t, bool final) {
     for (std::size_t g = 0; g < grids.size(); ++g) {
@@ -191,17 +223,19 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const std::uint64_t stop = options.max_steps ? std::min(options.max_steps, total_macro) : total_macro;
   for (;; ++m) {
     const double t = static_cast<double>(m) * macro;
-    if (m < stop && !hooks.before.empty()) {
+    if (m < stop && !run_hooks.before.empty()) {
       step.t = t;
       step.index = m;
-      MacroHooks::run(hooks.before, step);
+      MacroHooks::run(run_hooks.before, step);
     }
     if (probe_rows.take(t)) write_probes(t);
     if (vtk_frames.take(t)) write_vtk(t);
-    if (!grids.empty() && m > 0) {
+    if ((!grids.empty() || !couplings.empty()) && m > 0) {
       write_grids(t, false);
       refresh_accessible(t);
     }
+    if (m > 0)
+      for (auto& c : couplings) c->write_grids(t, false);
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
@@ -210,10 +244,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       particle_steps += ps;
       if (options.time_after && m >= options.time_after) window_particle_steps += ps;
     }
-    if (!hooks.after.empty()) {
+    if (!run_hooks.after.empty()) {
       step.t = static_cast<double>(m + 1) * macro;
       step.index = m;
-      MacroHooks::run(hooks.after, step);
+      MacroHooks::run(run_hooks.after, step);
     }
     const auto now = std::chrono::steady_clock::now();
     const double since = std::chrono::duration<double>(now - last_report).count();
@@ -234,6 +268,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (options.progress && tty) std::fprintf(stderr, "\n");
   if (probes) probes->flush();
   write_grids(static_cast<double>(m) * macro, true);
+  for (auto& c : couplings) c->write_grids(static_cast<double>(m) * macro, true);
 
   result.macro_steps = m;
   result.simulated_time = static_cast<double>(m) * macro;
@@ -269,6 +304,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                     {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)}});
   summary["plugin_libraries"] = libs;
   summary["models"] = models_used;
+  nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
   nlohmann::json sds = nlohmann::json::array();
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
     const auto& sd = subdomains[k];
@@ -306,6 +342,19 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     summary["repose_angle_deg"] = angles;
   }
   summary["subdomains"] = sds;
+  if (!couplings.empty()) {
+    nlohmann::json cj = nlohmann::json::object();
+    for (auto& c : couplings) {
+      cj[c->spec().name] = c->summary(subdomains, flow);
+      if (c->spec().grid_interval > 0)
+        files["couplings"][c->spec().name] = {{"balance", c->spec().name + "_balance.csv"},
+                                              {"fine_grid", c->spec().name + "_fine.pvd"},
+                                              {"coarse_grid", c->spec().name + "_coarse.pvd"}};
+      else
+        files["couplings"][c->spec().name] = {{"balance", c->spec().name + "_balance.csv"}};
+    }
+    summary["couplings"] = cj;
+  }
   if (!flow.empty()) {
     flow.check_planes(subdomains);
     const nlohmann::json flow_summary = flow.summary(subdomains);
@@ -318,7 +367,6 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                                {"wall_time_s", w},
                                {"particle_steps_per_s", w > 0 ? window_particle_steps / w : 0.0}};
   }
-  nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
   if (write_state) {
     for (const auto& sd : subdomains) {
       std::string f = sd->name() + "_state.csv";

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "averaging/cell_grid.hpp"
+#include "coupling/coupling.hpp"
 #include "core/material.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
@@ -80,6 +81,10 @@ class Simulation {
   };
   std::vector<GridSetup> grid_setups;
   std::vector<std::unique_ptr<CellGrid>> grids;  ///< built by run(), same order as grid_setups
+  /// Couplings between levels (coupling/coupling.hpp), all on one control
+  /// clock: every control_macro macro steps, after the flow's hooks.
+  std::vector<std::unique_ptr<Coupling>> couplings;
+  std::uint64_t control_macro = 0;
 
   /// Run to the end. Throws RuntimeError or PluginError on failure; every
   /// file written up to then is complete (written to a temporary name and renamed).

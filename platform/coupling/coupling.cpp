@@ -1,0 +1,482 @@
+// SPDX-License-Identifier: MIT
+// Coupling: removal at the region's faces, face counting of coarse parcels,
+// transfer by sequential simple inhibition (docs/physics.md §5.5, §6.2), the
+// controller views (§5.3, §5.4) and the interface balance.
+#include "coupling/coupling.hpp"
+
+#include "core/error.hpp"
+#include "io/cell_grid_output.hpp"
+#include "io/csv_series.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace domel::platform {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+const char* const kFaceNames[kFaces] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+
+double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+
+bool inside_box(const CellGridSpec& g, double x, double y, double z) {
+  return x >= g.lo[0] && x <= g.hi[0] && y >= g.lo[1] && y <= g.hi[1] && z >= g.lo[2] && z <= g.hi[2];
+}
+
+/// Consecutive transfers with a growing backlog before the warning.
+constexpr int kBacklogWarnAfter = 5;
+
+}  // namespace
+
+const char* face_name(int face) { return face >= 0 && face < kFaces ? kFaceNames[face] : "?"; }
+
+int face_from_name(const std::string& name) {
+  for (int f = 0; f < kFaces; ++f)
+    if (name == kFaceNames[f]) return f;
+  return -1;
+}
+
+Coupling::Coupling(CouplingSpec spec) : spec_(std::move(spec)), rng_(spec_.seed) {
+  CellGridSpec g = spec_.grid;
+  g.write_interval = spec_.grid_interval;
+  g.name = spec_.name + "_fine";
+  g.every = spec_.fine_steps;
+  fine_grid_ = std::make_unique<CellGrid>(g);
+  g.name = spec_.name + "_coarse";
+  g.every = spec_.coarse_steps;
+  coarse_grid_ = std::make_unique<CellGrid>(g);
+}
+
+Coupling::~Coupling() = default;
+
+double Coupling::shell_volume(int face) const {
+  const int a = face / 2;
+  double area = 1;
+  for (int b = 0; b < 3; ++b)
+    if (b != a) area *= spec_.grid.hi[b] - spec_.grid.lo[b];
+  return area * spec_.shell_depth;
+}
+
+void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const std::vector<WallPrimitive>& walls,
+                     const std::filesystem::path& out) {
+  fine_grid_->set_accessible(walls, 0.0);
+  coarse_grid_->set_accessible(walls, 0.0);
+  const ParticleStore& c = subdomains[spec_.coarse]->store();
+  const ParticleStore& f = subdomains[spec_.fine]->store();
+  const double scale = subdomains[spec_.fine]->coarse_grain() / subdomains[spec_.coarse]->coarse_grain();
+  for (double r : f.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r);
+  for (double r : c.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r * scale);
+  coarse_last_.clear();
+  for (std::size_t q = 0; q < c.size(); ++q) coarse_last_[c.id[q]] = {c.x[q], c.y[q], c.z[q]};
+  if (out.empty()) return;
+  std::vector<std::string> cols = {"time"};
+  for (int face = 0; face < kFaces; ++face) {
+    const std::string n = kFaceNames[face];
+    if (spec_.inflow[face])
+      for (const char* k : {".counted_kg", ".inserted_kg", ".pending_kg", ".backlog", ".velocity_z"})
+        cols.push_back(n + k);
+    cols.push_back(n + ".removed_kg");
+  }
+  for (const char* k : {"outlet_removed_kg", "holdup_kg", "fine_particles", "fine_balance_residual_kg"})
+    cols.emplace_back(k);
+  balance_ = std::make_unique<io::CsvSeries>(out / (spec_.name + "_balance.csv"), cols, 20);
+  if (spec_.grid_interval > 0) {
+    vtk_fine_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_fine");
+    vtk_coarse_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_coarse");
+    next_grid_file_ = spec_.grid_interval;
+  }
+}
+
+void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains,
+                        const std::vector<WallPrimitive>& walls, ParticleFlow& flow) {
+  Subdomain& fine = *subdomains[spec_.fine];
+  Subdomain& coarse = *subdomains[spec_.coarse];
+  const double interval = t - last_t_;
+  last_t_ = t;
+  ++controls_;
+  ++since_transfer_;
+  remove_escaped(fine, flow);
+  count_inflow(coarse);
+  bool due = since_transfer_ >= spec_.transfer_controls;
+  for (int face = 0; face < kFaces && !due; ++face) {
+    if (!spec_.inflow[face]) continue;
+    double owed = 0;
+    for (double r : faces_[face].queue) owed += sphere_volume(r);
+    due = owed - static_cast<double>(faces_[face].backlog) * sphere_volume(fine_dmax_ / 2) >=
+          spec_.fill_target * shell_volume(face);
+  }
+  if (due) transfer(t, fine, walls, flow);
+  control(t, interval, fine, coarse);
+}
+
+void Coupling::remove_escaped(Subdomain& fine, ParticleFlow& flow) {
+  ParticleStore& s = fine.store();
+  const CellGridSpec& g = spec_.grid;
+  std::vector<std::uint8_t> mark(s.size(), 0);
+  bool any = false;
+  for (std::size_t q = 0; q < s.size(); ++q) {
+    const double p[3] = {s.x[q], s.y[q], s.z[q]};
+    int face = -1;
+    double beyond = 0;
+    for (int a = 0; a < 3; ++a) {
+      if (g.lo[a] - p[a] > beyond) beyond = g.lo[a] - p[a], face = 2 * a;
+      if (p[a] - g.hi[a] > beyond) beyond = p[a] - g.hi[a], face = 2 * a + 1;
+    }
+    if (face < 0) continue;
+    mark[q] = 1;
+    any = true;
+    faces_[face].removed += mass_units(s.mass[q]);
+    ++faces_[face].n_removed;
+    flow.count_removed(spec_.fine, s.id[q], s.mass[q]);
+  }
+  if (any) s.remove_marked(mark);
+}
+
+void Coupling::count_inflow(const Subdomain& coarse) {
+  const ParticleStore& s = coarse.store();
+  const CellGridSpec& g = spec_.grid;
+  std::unordered_map<std::uint64_t, std::array<double, 3>> now;
+  now.reserve(s.size());
+  for (std::size_t q = 0; q < s.size(); ++q) {
+    const std::array<double, 3> p = {s.x[q], s.y[q], s.z[q]};
+    now.emplace(s.id[q], p);
+    const auto it = coarse_last_.find(s.id[q]);
+    if (it == coarse_last_.end()) continue;  // new since the last count
+    const auto& prev = it->second;
+    if (inside_box(g, prev[0], prev[1], prev[2]) || !inside_box(g, p[0], p[1], p[2])) continue;
+    // Entered the box: the face crossed last on the segment prev -> now.
+    int face = -1;
+    double last = -1;
+    for (int a = 0; a < 3; ++a) {
+      const double d = p[a] - prev[a];
+      if (prev[a] < g.lo[a] && d > 0) {
+        const double u = (g.lo[a] - prev[a]) / d;
+        if (u > last) last = u, face = 2 * a;
+      } else if (prev[a] > g.hi[a] && d < 0) {
+        const double u = (g.hi[a] - prev[a]) / d;
+        if (u > last) last = u, face = 2 * a + 1;
+      }
+    }
+    if (face < 0 || !spec_.inflow[face] || !counted_ids_.insert(s.id[q]).second) continue;
+    FaceBalance& fb = faces_[face];
+    const double m = s.mass[q];
+    fb.counted += mass_units(m);
+    ++fb.parcels;
+    fb.mass_open += m;
+    fb.momentum[0] += m * s.vx[q];
+    fb.momentum[1] += m * s.vy[q];
+    fb.momentum[2] += m * s.vz[q];
+    // (alpha_c/alpha_f)^3 fine particles of the resolved size times alpha_f,
+    // exactly the parcel's mass: count = m_parcel / m_fine (physics.md §5.5)
+    const double r_fine = s.radius[q] * spec_.alpha_ratio;
+    const double m_fine = spec_.fine_density * sphere_volume(r_fine);
+    const double owed = fb.fraction + m / m_fine;
+    // a ratio that is a whole number up to round-off gives that many particles
+    const double whole = std::floor(owed + 1e-9);
+    fb.fraction = std::max(0.0, owed - whole);
+    for (double k = 0; k < whole; ++k) fb.queue.push_back(r_fine);
+    fine_dmax_ = std::max(fine_dmax_, 2 * r_fine);
+  }
+  coarse_last_.swap(now);
+}
+
+void Coupling::transfer(double t, Subdomain& fine, const std::vector<WallPrimitive>& walls, ParticleFlow& flow) {
+  ++transfers_;
+  since_transfer_ = 0;
+  ParticleStore& s = fine.store();
+  const std::size_t first = s.size();
+  for (int face = 0; face < kFaces; ++face) {
+    if (!spec_.inflow[face]) continue;
+    FaceBalance& fb = faces_[face];
+    if (fb.mass_open > 0)
+      for (int a = 0; a < 3; ++a) fb.velocity[a] = fb.momentum[a] / fb.mass_open;
+    fb.mass_open = 0;
+    fb.momentum[0] = fb.momentum[1] = fb.momentum[2] = 0;
+    const std::size_t before = s.size();
+    insert_face(face, t, fine, walls, flow.next_id);
+    for (std::size_t k = before; k < s.size(); ++k) {
+      fb.inserted += mass_units(s.mass[k]);
+      ++fb.n_inserted;
+      flow.count_inserted(spec_.fine, s.mass[k]);
+    }
+    const std::uint64_t backlog = fb.queue.size();
+    fb.growing = backlog > fb.backlog && backlog > 0 ? fb.growing + 1 : 0;
+    fb.backlog = backlog;
+    if (fb.growing >= kBacklogWarnAfter && !fb.warned) {
+      fb.warned = true;
+      spdlog::warn("{}: face {} could not place its fine particles for {} transfers in a row (backlog {} at t = "
+                   "{:.4g} s): the material behind the face is packed; the backlog waits for room (a larger "
+                   "shell_depth gives it more)",
+                   spec_.where, kFaceNames[face], fb.growing, backlog, t);
+    }
+  }
+  if (s.size() > first) fine.apply_body_forces(first, s.size());  // their first half kick sees their body forces
+  write_row(t, fine, flow);
+}
+
+std::size_t Coupling::insert_face(int face, double t, Subdomain& fine, const std::vector<WallPrimitive>& walls,
+                                  std::uint64_t& next_id) {
+  FaceBalance& fb = faces_[face];
+  if (fb.queue.empty()) return 0;
+  ParticleStore& s = fine.store();
+  const CellGridSpec& g = spec_.grid;
+  double lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) lo[a] = g.lo[a], hi[a] = g.hi[a];
+  const int ax = face / 2;
+  if (face % 2 == 1) lo[ax] = hi[ax] - spec_.shell_depth;
+  else hi[ax] = lo[ax] + spec_.shell_depth;
+  double rmax = 0;
+  for (double r : fb.queue) rmax = std::max(rmax, r);
+  for (double r : s.radius) rmax = std::max(rmax, r);
+  // A uniform hash of the fine particles near the shell (cell edge 2 r_max):
+  // a candidate overlaps only particles in its own and the 26 cells around.
+  const double h = 2 * rmax;
+  int n[3];
+  double o[3];
+  for (int a = 0; a < 3; ++a) {
+    o[a] = lo[a] - h;
+    n[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a] + 2 * h) / h)));
+  }
+  std::vector<std::vector<std::uint32_t>> bins(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+  auto bin_of = [&](double x, double y, double z, int c[3]) {
+    const double p[3] = {x, y, z};
+    for (int a = 0; a < 3; ++a) c[a] = static_cast<int>(std::floor((p[a] - o[a]) / h));
+    return c[0] >= 0 && c[1] >= 0 && c[2] >= 0 && c[0] < n[0] && c[1] < n[1] && c[2] < n[2];
+  };
+  auto add_to_bins = [&](std::size_t k) {
+    int c[3];
+    if (bin_of(s.x[k], s.y[k], s.z[k], c))
+      bins[c[0] + static_cast<std::size_t>(n[0]) * (c[1] + static_cast<std::size_t>(n[1]) * c[2])].push_back(
+          static_cast<std::uint32_t>(k));
+  };
+  for (std::size_t k = 0; k < s.size(); ++k) add_to_bins(k);
+  std::vector<const WallPrimitive*> active;
+  for (const auto& w : walls)
+    if (w.active(t)) active.push_back(&w);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::size_t placed = 0;
+  while (!fb.queue.empty()) {
+    const double r = fb.queue.front();
+    bool ok = false;
+    double p[3];
+    for (int attempt = 0; attempt < spec_.attempts && !ok; ++attempt) {
+      bool room = true;
+      for (int a = 0; a < 3; ++a) {
+        const double a0 = lo[a] + r, a1 = hi[a] - r;
+        if (a1 < a0) room = false;
+        p[a] = a0 + (a1 - a0) * u01(rng_);
+      }
+      if (!room) break;
+      ok = true;
+      for (const WallPrimitive* w : active)
+        if (w->shape != WallPrimitive::Shape::mesh && w->near(p[0], p[1], p[2], r)) {
+          ok = false;
+          break;
+        }
+      if (!ok) continue;
+      int c[3];
+      bin_of(p[0], p[1], p[2], c);
+      for (int dz = -1; dz <= 1 && ok; ++dz)
+        for (int dy = -1; dy <= 1 && ok; ++dy)
+          for (int dx = -1; dx <= 1 && ok; ++dx) {
+            const int b[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
+            if (b[0] < 0 || b[1] < 0 || b[2] < 0 || b[0] >= n[0] || b[1] >= n[1] || b[2] >= n[2]) continue;
+            for (std::uint32_t k : bins[b[0] + static_cast<std::size_t>(n[0]) * (b[1] + static_cast<std::size_t>(n[1]) * b[2])]) {
+              const double dxp = p[0] - s.x[k], dyp = p[1] - s.y[k], dzp = p[2] - s.z[k];
+              const double rr = r + s.radius[k];
+              if (dxp * dxp + dyp * dyp + dzp * dzp < rr * rr) {
+                ok = false;
+                break;
+              }
+            }
+          }
+    }
+    if (!ok) break;  // the shell has no room for this one: it and the rest wait
+    s.add(next_id++, p[0], p[1], p[2], r, spec_.fine_density, false);
+    const std::size_t k = s.size() - 1;
+    s.vx[k] = fb.velocity[0];
+    s.vy[k] = fb.velocity[1];
+    s.vz[k] = fb.velocity[2];
+    add_to_bins(k);
+    fb.queue.pop_front();
+    ++placed;
+  }
+  return placed;
+}
+
+void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& coarse) {
+  if (!spec_.stress.enabled && !spec_.velocity.enabled) return;
+  const CellFields& ff = fine_grid_->latest();
+  const CellFields& fc = coarse_grid_->latest();
+  const double tol = 1e-6 * interval;
+  if (ff.samples == 0 || fc.samples == 0 || std::fabs(ff.time - t) > tol || std::fabs(fc.time - t) > tol)
+    throw RuntimeError(spec_.where + ": the cell averages at t = " + std::to_string(t) + " s are missing (fine " +
+                       std::to_string(ff.time) + " s, coarse " + std::to_string(fc.time) +
+                       " s): the levels' sampling is out of step with the control interval");
+  const std::size_t nc = fine_grid_->cell_count();
+  auto grid_view = [&](const CellFields& f, std::vector<std::uint32_t>& count, std::vector<double>& stress) {
+    count.resize(nc);
+    stress.resize(6 * nc);
+    for (std::size_t c = 0; c < nc; ++c) {
+      count[c] = static_cast<std::uint32_t>(f.count[c]);
+      // ABI: xx, yy, zz, xy, xz, yz with compression negative; CellFields: 9 entries, compression positive
+      const double* sg = &f.stress[9 * c];
+      const int pick[6] = {0, 4, 8, 1, 2, 5};
+      for (int e = 0; e < 6; ++e) stress[6 * c + e] = -sg[pick[e]];
+    }
+    domel_cell_grid_v1 v{};
+    v.struct_size = sizeof v;
+    v.nx = static_cast<uint32_t>(spec_.grid.cells[0]);
+    v.ny = static_cast<uint32_t>(spec_.grid.cells[1]);
+    v.nz = static_cast<uint32_t>(spec_.grid.cells[2]);
+    for (int a = 0; a < 3; ++a) {
+      v.origin[a] = spec_.grid.lo[a];
+      v.spacing[a] = fine_grid_->cell_size()[a];
+    }
+    v.n_cells = nc;
+    v.count = count.data();
+    v.volume_fraction = f.volume_fraction.data();
+    v.mass = f.mass.data();
+    v.ux = f.vx.data(), v.uy = f.vy.data(), v.uz = f.vz.data();
+    v.u_min_x = f.vmin_x.data(), v.u_min_y = f.vmin_y.data(), v.u_min_z = f.vmin_z.data();
+    v.u_max_x = f.vmax_x.data(), v.u_max_y = f.vmax_y.data(), v.u_max_z = f.vmax_z.data();
+    v.stress = stress.data();
+    return v;
+  };
+  domel_cell_grid_v1 gf = grid_view(ff, count_f_, stress_f_);
+  domel_cell_grid_v1 gc = grid_view(fc, count_c_, stress_c_);
+  struct Forces {
+    std::vector<double> x, y, z;
+  } force_f, force_c;
+  auto particle_view = [&](Subdomain& sd, std::vector<std::uint32_t>& cell, Forces& force) {
+    ParticleStore& s = sd.store();
+    const std::size_t n = s.size();
+    cell.resize(n);
+    for (std::size_t q = 0; q < n; ++q) {
+      const std::ptrdiff_t c = fine_grid_->cell_of(s.x[q], s.y[q], s.z[q]);
+      cell[q] = c < 0 ? UINT32_MAX : static_cast<std::uint32_t>(c);
+    }
+    force.x.assign(n, 0.0), force.y.assign(n, 0.0), force.z.assign(n, 0.0);
+    domel_particles_v1 v{};
+    v.struct_size = sizeof v;
+    v.n = n;
+    v.id = s.id.data();
+    v.x = s.x.data(), v.y = s.y.data(), v.z = s.z.data();
+    v.vx = s.vx.data(), v.vy = s.vy.data(), v.vz = s.vz.data();
+    v.mass = s.mass.data();
+    v.radius = s.radius.data();
+    v.cell = cell.data();
+    v.fx = force.x.data(), v.fy = force.y.data(), v.fz = force.z.data();
+    return v;
+  };
+  domel_particles_v1 pf = particle_view(fine, cell_f_, force_f);
+  domel_particles_v1 pc = particle_view(coarse, cell_c_, force_c);
+  domel_level_v1 lf{sizeof(domel_level_v1), 0, fine.name().c_str(), fine.coarse_grain(), &gf, &pf};
+  domel_level_v1 lc{sizeof(domel_level_v1), 0, coarse.name().c_str(), coarse.coarse_grain(), &gc, &pc};
+  domel_level_v1* levels[2] = {&lf, &lc};
+  domel_control_step_v1 step{sizeof(domel_control_step_v1), 2, t, interval, levels};
+  try {
+    if (spec_.stress.enabled) spec_.stress.model->control(step);
+    if (spec_.velocity.enabled) spec_.velocity.model->control(step);
+  } catch (const PluginError& e) {
+    throw RuntimeError(spec_.where + ": a controller failed at t = " + std::to_string(t) + " s: " + e.what());
+  }
+  auto apply = [](ParticleStore& s, const Forces& f) {
+    for (std::size_t q = 0; q < s.size(); ++q) {
+      s.ext_fx[q] += f.x[q];
+      s.ext_fy[q] += f.y[q];
+      s.ext_fz[q] += f.z[q];
+    }
+  };
+  apply(fine.store(), force_f);
+  apply(coarse.store(), force_c);
+}
+
+void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& flow) {
+  if (!balance_) return;
+  std::vector<double> row = {t};
+  MassUnits at_faces = 0;
+  for (int face = 0; face < kFaces; ++face) {
+    const FaceBalance& fb = faces_[face];
+    if (spec_.inflow[face]) {
+      row.push_back(mass_kg(fb.counted));
+      row.push_back(mass_kg(fb.inserted));
+      row.push_back(mass_kg(fb.pending()));
+      row.push_back(static_cast<double>(fb.backlog));
+      row.push_back(fb.velocity[2]);
+    }
+    row.push_back(mass_kg(fb.removed));
+    at_faces += fb.removed;
+  }
+  const ParticleStore& s = fine.store();
+  MassUnits present = 0;
+  for (double m : s.mass) present += mass_units(m);
+  row.push_back(mass_kg(flow.accounts().at(spec_.fine).removed - at_faces));
+  row.push_back(mass_kg(present));
+  row.push_back(static_cast<double>(s.size()));
+  row.push_back(mass_kg(flow.residual(spec_.fine, s)));
+  balance_->append(row);
+}
+
+void Coupling::write_grids(double t, bool final) {
+  if (!vtk_fine_) return;
+  if (!final && t < next_grid_file_ - 1e-12) return;
+  while (next_grid_file_ <= t + 1e-12) next_grid_file_ += spec_.grid_interval;
+  if (fine_grid_->samples_pending() > 0) vtk_fine_->write(t, *fine_grid_, fine_grid_->mean_since_last_take());
+  if (coarse_grid_->samples_pending() > 0)
+    vtk_coarse_->write(t, *coarse_grid_, coarse_grid_->mean_since_last_take());
+}
+
+nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleFlow& flow) {
+  const Subdomain& fine = *subdomains[spec_.fine];
+  if (balance_) {
+    write_row(last_t_, fine, flow);
+    balance_->flush();
+  }
+  nlohmann::json faces = nlohmann::json::object();
+  MassUnits at_faces = 0, counted = 0, inserted = 0, pending = 0;
+  for (int face = 0; face < kFaces; ++face) {
+    const FaceBalance& fb = faces_[face];
+    at_faces += fb.removed;
+    nlohmann::json j = {{"removed_kg", mass_kg(fb.removed)}, {"removed", fb.n_removed}};
+    if (spec_.inflow[face]) {
+      counted += fb.counted;
+      inserted += fb.inserted;
+      pending += fb.pending();
+      j["counted_kg"] = mass_kg(fb.counted);
+      j["counted_parcels"] = fb.parcels;
+      j["inserted_kg"] = mass_kg(fb.inserted);
+      j["inserted"] = fb.n_inserted;
+      j["pending_kg"] = mass_kg(fb.pending());
+      j["backlog"] = fb.backlog;
+      double owed = fb.fraction * spec_.fine_density * sphere_volume(fine_dmax_ / 2);
+      for (double r : fb.queue) owed += spec_.fine_density * sphere_volume(r);
+      j["owed_particles"] = fb.queue.size();
+      j["owed_kg"] = owed;  // the queue's own mass: pending_kg up to the parcels' round-off
+    }
+    faces[kFaceNames[face]] = j;
+  }
+  MassUnits present = 0;
+  for (double m : fine.store().mass) present += mass_units(m);
+  return {{"coarse", subdomains[spec_.coarse]->name()},
+          {"fine", fine.name()},
+          {"control_interval_fine_steps", spec_.fine_steps},
+          {"control_interval_coarse_steps", spec_.coarse_steps},
+          {"control_intervals", controls_},
+          {"transfers", transfers_},
+          {"faces", faces},
+          {"counted_kg", mass_kg(counted)},
+          {"inserted_kg", mass_kg(inserted)},
+          {"pending_kg", mass_kg(pending)},
+          {"removed_at_faces_kg", mass_kg(at_faces)},
+          {"removed_at_outlet_kg", mass_kg(flow.accounts().at(spec_.fine).removed - at_faces)},
+          {"holdup_kg", mass_kg(present)},
+          {"stress_control", spec_.stress.enabled ? spec_.stress.params : nlohmann::json(false)},
+          {"velocity_control", spec_.velocity.enabled ? spec_.velocity.params : nlohmann::json(false)}};
+}
+
+}  // namespace domel::platform

@@ -1,0 +1,168 @@
+// SPDX-License-Identifier: MIT
+// A coupling between two resolution levels (the Domain-Element Model,
+// docs/multilevel.md; the algorithms of docs/physics.md §5 as LIGGGHTS-PFM
+// codes them): a fine subdomain lives inside a box (the region) of its
+// coarse parent's domain, split into hexahedral cells on which both levels
+// are averaged. At every control interval, at a time that is a step of both
+// levels, the coupling
+//   1. removes the fine particles whose centre has left the region and books
+//      them as outflow of the face they crossed;
+//   2. counts the coarse parcels that entered the region through an inflow
+//      face since the last interval, once per parcel (mass, momentum, size);
+//   3. when a transfer is due (the counted material would fill a face's
+//      insertion shell beyond fill_target, or transfer_max_steps passed),
+//      turns what each face counted into fine particles
+//      (alpha_c/alpha_f)^3 per parcel, placed in the shell behind the face by
+//      sequential simple inhibition with the face's mass-weighted velocity;
+//      what cannot be placed waits (the backlog);
+//   4. hands both levels' cell averages (sampled at the step that ended at
+//      this time) and particles to its two controller plugins, the fine
+//      boundary PI stress controller and the coarse P velocity controller,
+//      whose forces the levels then carry as external forces until the next
+//      interval.
+// Nothing here reads a level's state from the future: every exchange runs
+// between macro steps, when all levels stand at the same time.
+#pragma once
+
+#include "averaging/cell_grid.hpp"
+#include "geometry/wall.hpp"
+#include "loader/plugin_registry.hpp"
+#include "scheduler/particle_flow.hpp"
+#include "subdomain/subdomain.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace domel::platform {
+
+namespace io {
+class CsvSeries;
+class CellGridVtkSeries;
+}  // namespace io
+
+/// Faces of the region box: -x, +x, -y, +y, -z, +z.
+inline constexpr int kFaces = 6;
+const char* face_name(int face);
+/// "-x" ... "+z" -> 0 ... 5; -1 for anything else.
+int face_from_name(const std::string& name);
+
+struct ControllerSetup {
+  bool enabled = false;
+  std::shared_ptr<ModelInstance> model;
+  nlohmann::json params;  ///< what the model was created with (defaults filled), for summary.json
+};
+
+/// A coupling as the scenario describes it, resolved by the builder.
+struct CouplingSpec {
+  std::string name;
+  std::string where;  ///< JSON pointer of the block, for messages
+  std::size_t coarse = 0, fine = 0;  ///< subdomain indices
+  CellGridSpec grid;                 ///< the region and its cells; `every` is set by the coupling
+  std::array<bool, kFaces> inflow{};
+  double fine_density = 0;           ///< [kg/m^3] of the fine level's material
+  double alpha_ratio = 0.5;          ///< alpha_fine / alpha_coarse
+  double shell_depth = 0;            ///< [m]
+  double fill_target = 0.1;
+  int attempts = 1000;
+  double grid_interval = 0;          ///< [s] between grid files; 0: none
+  std::uint64_t seed = 1;
+  // timing, resolved from the levels' sub-steps per macro step
+  std::uint64_t control_macro = 1;   ///< macro steps per control interval
+  int fine_steps = 1;                ///< fine steps per control interval (N)
+  int coarse_steps = 1;              ///< coarse steps per control interval
+  std::uint64_t transfer_controls = 1;  ///< control intervals per transfer, at most
+  ControllerSetup stress;            ///< acts on the fine level
+  ControllerSetup velocity;          ///< acts on the coarse level
+};
+
+/// The books of one face, in the integer mass units of the flow balance
+/// (particle_flow.hpp): counted = inserted + pending exactly; removed is
+/// the fine outflow through the face.
+struct FaceBalance {
+  MassUnits counted = 0, inserted = 0, removed = 0;
+  std::uint64_t parcels = 0;           ///< coarse parcels counted
+  std::uint64_t n_inserted = 0, n_removed = 0;
+  std::deque<double> queue;            ///< radii of the fine particles still to insert (the backlog first)
+  double fraction = 0;                 ///< fine particles owed beyond the whole ones in the queue
+  // this transfer interval
+  double mass_open = 0;                ///< [kg] counted since the last transfer
+  double momentum[3] = {0, 0, 0};      ///< [kg m/s] of what was counted since the last transfer
+  double velocity[3] = {0, 0, 0};      ///< [m/s] given to inserted particles (the last interval's mean)
+  std::uint64_t backlog = 0;           ///< particles that could not be placed at the last transfer
+  int growing = 0;                     ///< consecutive transfers with a growing backlog
+  bool warned = false;
+  MassUnits pending() const { return counted - inserted; }
+};
+
+class Coupling {
+ public:
+  explicit Coupling(CouplingSpec spec);
+  ~Coupling();
+  Coupling(const Coupling&) = delete;
+  Coupling& operator=(const Coupling&) = delete;
+
+  const CouplingSpec& spec() const { return spec_; }
+  /// The two levels' averages on the region's cells; the run loop samples
+  /// them on the steps they are due (every control interval of each level).
+  CellGrid& fine_grid() { return *fine_grid_; }
+  CellGrid& coarse_grid() { return *coarse_grid_; }
+  const std::array<FaceBalance, kFaces>& faces() const { return faces_; }
+
+  /// Before the first step: accessible volumes, the coarse parcels' sides,
+  /// the balance file. `out` empty: no files.
+  void start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const std::vector<WallPrimitive>& walls,
+             const std::filesystem::path& out);
+  /// One control interval at time t (all levels stand at t): steps 1-4 of
+  /// the file comment. External forces of both levels must have been zeroed
+  /// by the caller (several couplings add into the same level).
+  void exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains,
+                const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
+  /// Grid files due at t (or the last ones when final).
+  void write_grids(double t, bool final);
+  /// Close the balance file and describe the coupling for summary.json.
+  nlohmann::json summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleFlow& flow);
+
+  /// Statistics of the run so far.
+  std::uint64_t transfers() const { return transfers_; }
+  std::uint64_t control_calls() const { return controls_; }
+  double last_exchange_time() const { return last_t_; }
+
+ private:
+  void remove_escaped(Subdomain& fine, ParticleFlow& flow);
+  void count_inflow(const Subdomain& coarse);
+  void transfer(double t, Subdomain& fine, const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
+  std::size_t insert_face(int face, double t, Subdomain& fine, const std::vector<WallPrimitive>& walls,
+                          std::uint64_t& next_id);
+  void control(double t, double interval, Subdomain& fine, Subdomain& coarse);
+  void write_row(double t, const Subdomain& fine, const ParticleFlow& flow);
+  double shell_volume(int face) const;
+
+  CouplingSpec spec_;
+  std::unique_ptr<CellGrid> fine_grid_, coarse_grid_;
+  std::array<FaceBalance, kFaces> faces_;
+  std::unordered_map<std::uint64_t, std::array<double, 3>> coarse_last_;  ///< parcel id -> position at the last count
+  std::unordered_set<std::uint64_t> counted_ids_;                         ///< parcels already counted (count once)
+  std::mt19937_64 rng_;
+  std::uint64_t controls_ = 0, transfers_ = 0;
+  std::uint64_t since_transfer_ = 0;  ///< control intervals since the last transfer
+  double last_t_ = 0;
+  double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
+  std::unique_ptr<io::CsvSeries> balance_;
+  std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;
+  double next_grid_file_ = 0;
+  // scratch of the controller views
+  std::vector<std::uint32_t> cell_f_, cell_c_, count_f_, count_c_;
+  std::vector<double> stress_f_, stress_c_;
+};
+
+}  // namespace domel::platform
