@@ -339,7 +339,11 @@ void build_subdomain(Build& b, std::size_t k) {
   if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
   // The fine level of a coupling starts empty: its particles will be its
   // parent's parcels at its own ratio, which set its skin and time step.
-  if (auto it = b.parent.find(sd_name); it != b.parent.end()) {
+  bool coarse_listed = false;  // a self-coupling or an unknown name is build_couplings()'s to report
+  if (auto it = b.parent.find(sd_name); it != b.parent.end() && it->second.first != sd_name) {
+    for (const auto& other : b.doc["subdomains"]) coarse_listed = coarse_listed || other["name"] == it->second.first;
+  }
+  if (auto it = b.parent.find(sd_name); coarse_listed) {
     const auto pr = b.radii.find(it->second.first);
     if (pr == b.radii.end()) {
       b.ck.add(idx("/couplings", it->second.second) + "/coarse",
@@ -652,6 +656,7 @@ void build_couplings(Build& b) {
     s.transfer_controls = std::max<std::uint64_t>(1, (tmax + s.fine_steps - 1) / s.fine_steps);
     const double dt_f = macro / n_f, dt_c = macro / n_c;
     const std::size_t n_cells = static_cast<std::size_t>(s.grid.cells[0]) * s.grid.cells[1] * s.grid.cells[2];
+    std::size_t block_before = b.ck.diags.size();
     auto controller = [&](const char* key, ControllerSetup& setup, json params) {
       const json& blk = cj[key];
       setup.enabled = blk["enabled"].get<bool>();
@@ -661,6 +666,10 @@ void build_couplings(Build& b) {
       if (m == nullptr) {
         b.ck.add(base + "/" + key + "/model", "unknown controller model '" + model + "'",
                  suggest(model, b.registry.names(DOMEL_KIND_CONTROLLER)));
+        setup.enabled = false;
+        return;
+      }
+      if (b.ck.diags.size() > block_before) {  // the block's own problems are reported; the model is not asked
         setup.enabled = false;
         return;
       }
@@ -678,6 +687,7 @@ void build_couplings(Build& b) {
     };
     // stress control: default cells touch an inflow face; direction: the inward normals
     {
+      block_before = b.ck.diags.size();
       const json& blk = cj["stress_control"];
       json cells = json::array(), dirs = json::array();
       if (blk.contains("cells")) {
@@ -723,6 +733,7 @@ void build_couplings(Build& b) {
       controller("stress_control", s.stress, p);
     }
     {
+      block_before = b.ck.diags.size();
       const json& blk = cj["velocity_control"];
       json cells = json::array();
       if (blk.contains("cells")) cells = blk["cells"];

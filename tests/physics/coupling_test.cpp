@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: MIT
+// Guards the coupling between levels (issue 14; coupling/coupling.hpp,
+// docs/multilevel.md): coarse parcels crossing an inflow face are counted
+// once, with their mass, and become (alpha_c/alpha_f)^3 fine particles each,
+// placed without overlap in the shell behind the face with the face's
+// mass-weighted velocity; what cannot be placed waits as backlog; fine
+// particles leaving the region are removed and booked to the face they
+// crossed; the mass books close exactly; and in a run every exchange happens
+// when all levels stand at the same time, on a step of each.
+#include "coupling/coupling.hpp"
+#include "support/fixture.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace dt = domel::test;
+namespace dp = domel::platform;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kD = 0.0028;  // fine diameter; coarse parcels are 2 kD
+constexpr double kPi = 3.14159265358979323846;
+
+/// A coarse level (alpha 2) filling [0, 0.06]^3 on a lattice and an empty
+/// fine level (alpha 1) coupled on the box [0, 0.06]^2 x [0, 0.03] with +z
+/// as inflow face, controllers off (they are tested on their own), a
+/// transfer at every control interval.
+json two_level(double gravity = 0.0) {
+  json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
+  doc["gravity"] = {0, 0, gravity};
+  json coarse = {{"name", "coarse"}, {"material", "m"}, {"coarse_grain", 2}, {"contact", dt::hertz_mindlin()},
+                 {"time_step", 3.6e-5}};
+  coarse["insert"] = {{{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.05},
+                       {"region", {{"box", {{"min", {0, 0, 0}}, {"max", {0.06, 0.06, 0.06}}}}}}}};
+  json fine = {{"name", "fine"}, {"material", "m"}, {"coarse_grain", 1}, {"contact", dt::hertz_mindlin()},
+               {"time_step", 1.8e-5}};
+  doc["subdomains"] = {coarse, fine};
+  doc["couplings"] = {{{"name", "zone"},
+                       {"coarse", "coarse"},
+                       {"fine", "fine"},
+                       {"region", {{"min", {0, 0, 0}}, {"max", {0.06, 0.06, 0.03}}, {"cells", {2, 2, 1}}}},
+                       {"inflow_faces", {"+z"}},
+                       {"transfer_max_steps", 1},
+                       {"stress_control", {{"enabled", false}}},
+                       {"velocity_control", {{"enabled", false}}}}};
+  return doc;
+}
+
+struct Levels {
+  std::unique_ptr<dp::Simulation> sim;
+  dp::Coupling* c = nullptr;
+  dp::ParticleStore& coarse() { return sim->subdomains[0]->store(); }
+  dp::ParticleStore& fine() { return sim->subdomains[1]->store(); }
+  void exchange(double t) { c->exchange(t, sim->subdomains, sim->walls, sim->flow); }
+};
+
+Levels make(const json& doc) {
+  Levels s;
+  s.sim = dt::build(doc);
+  s.sim->flow.start(s.sim->subdomains);
+  s.c = s.sim->couplings.at(0).get();
+  s.c->start(s.sim->subdomains, s.sim->walls, {});
+  return s;
+}
+
+/// Indices of `n` coarse parcels whose centre lies above the region.
+std::vector<std::size_t> above(const dp::ParticleStore& s, std::size_t n) {
+  std::vector<std::size_t> out;
+  for (std::size_t q = 0; q < s.size() && out.size() < n; ++q)
+    if (s.z[q] > 0.04) out.push_back(q);
+  return out;
+}
+
+dp::MassUnits fine_mass_units(const dp::ParticleStore& s) {
+  dp::MassUnits u = 0;
+  for (double m : s.mass) u += dp::mass_units(m);
+  return u;
+}
+
+}  // namespace
+
+TEST(Coupling, CountsEachParcelOnceAndInsertsItsFineParticlesInTheShell) {
+  Levels s = make(two_level());
+  const auto& spec = s.c->spec();
+  EXPECT_DOUBLE_EQ(spec.shell_depth, 2 * 2 * kD);  // default: 2 coarse diameters
+  auto& c = s.coarse();
+  const auto moved = above(c, 5);
+  ASSERT_EQ(moved.size(), 5u);
+  // five parcels cross +z; distinct velocities, so the mass-weighted mean is checkable
+  double mass = 0, mom[3] = {0, 0, 0};
+  dp::MassUnits units = 0;
+  for (std::size_t k = 0; k < moved.size(); ++k) {
+    const std::size_t q = moved[k];
+    c.z[q] = 0.025;
+    c.vx[q] = 0.1 * k;
+    c.vy[q] = -0.05;
+    c.vz[q] = -0.5 - 0.1 * k;
+    mass += c.mass[q];
+    units += dp::mass_units(c.mass[q]);
+    mom[0] += c.mass[q] * c.vx[q];
+    mom[1] += c.mass[q] * c.vy[q];
+    mom[2] += c.mass[q] * c.vz[q];
+  }
+  // one parcel enters through -x, which is not an inflow face: first outside, then in
+  const std::size_t side = above(c, 6).back();
+  c.x[side] = -0.01;
+  c.z[side] = 0.01;
+  s.exchange(1e-3);
+  c.x[side] = 0.01;
+  s.exchange(2e-3);
+
+  const dp::FaceBalance& top = s.c->faces()[5];
+  EXPECT_EQ(top.parcels, 5u);
+  EXPECT_EQ(top.counted, units);
+  // alpha_c/alpha_f = 2: 8 fine particles of diameter kD per parcel, all placed in a shell this empty
+  auto& f = s.fine();
+  EXPECT_EQ(top.n_inserted, 40u);
+  EXPECT_EQ(f.size(), 40u);
+  EXPECT_EQ(top.queue.size(), 0u);
+  EXPECT_EQ(top.inserted, fine_mass_units(f));
+  // the parcel's mass, split in 8: what is left pending is round-off of the radius scaling only
+  EXPECT_LT(std::fabs(dp::mass_kg(top.pending())), 1e-12 * mass);
+  for (std::size_t q = 0; q < f.size(); ++q) {
+    EXPECT_NEAR(f.radius[q], kD / 2, 1e-15);
+    // entirely inside the shell [0.03 - L, 0.03] and the region's lateral extent
+    EXPECT_GE(f.z[q] - f.radius[q], 0.03 - spec.shell_depth - 1e-12);
+    EXPECT_LE(f.z[q] + f.radius[q], 0.03 + 1e-12);
+    EXPECT_GE(f.x[q] - f.radius[q], -1e-12);
+    EXPECT_LE(f.x[q] + f.radius[q], 0.06 + 1e-12);
+    EXPECT_NEAR(f.vx[q], mom[0] / mass, 1e-12);
+    EXPECT_NEAR(f.vy[q], mom[1] / mass, 1e-12);
+    EXPECT_NEAR(f.vz[q], mom[2] / mass, 1e-12);
+    for (std::size_t p = 0; p < q; ++p) {
+      const double d = std::hypot(f.x[q] - f.x[p], f.y[q] - f.y[p], f.z[q] - f.z[p]);
+      EXPECT_GE(d, f.radius[q] + f.radius[p]) << "fine particles " << p << " and " << q << " overlap";
+    }
+  }
+  // leave and come back: counted once
+  c.z[moved[0]] = 0.05;
+  s.exchange(3e-3);
+  c.z[moved[0]] = 0.02;
+  s.exchange(4e-3);
+  EXPECT_EQ(top.parcels, 5u);
+  EXPECT_EQ(s.sim->flow.residual(1, f), 0);
+}
+
+TEST(Coupling, RemovesFineParticlesThatLeaveAndBooksTheFaceTheyCrossed) {
+  Levels s = make(two_level());
+  auto& c = s.coarse();
+  for (std::size_t q : above(c, 2)) c.z[q] = 0.02;
+  s.exchange(1e-3);
+  auto& f = s.fine();
+  ASSERT_EQ(f.size(), 16u);
+  const double m_out_x = f.mass[0], m_out_z = f.mass[1];
+  f.x[0] = 0.0601;   // beyond +x
+  f.z[1] = -0.0005;  // beyond -z
+  f.x[2] = 0.03;     // still inside
+  s.exchange(2e-3);
+  const auto& faces = s.c->faces();
+  EXPECT_EQ(faces[1].n_removed, 1u);
+  EXPECT_EQ(faces[1].removed, dp::mass_units(m_out_x));
+  EXPECT_EQ(faces[4].n_removed, 1u);
+  EXPECT_EQ(faces[4].removed, dp::mass_units(m_out_z));
+  EXPECT_EQ(f.size(), 14u);
+  EXPECT_EQ(s.sim->flow.residual(1, f), 0);
+}
+
+TEST(Coupling, WhatCannotBePlacedWaitsAsBacklog) {
+  json doc = two_level();
+  // a fine bed packed on a cubic lattice right up to the face: no room in the shell
+  doc["subdomains"][1]["insert"] = {{{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.0},
+                                     {"region", {{"box", {{"min", {0, 0, 0.0}}, {"max", {0.06, 0.06, 0.03}}}}}}}};
+  Levels s = make(doc);
+  const std::size_t before = s.fine().size();
+  for (std::size_t q : above(s.coarse(), 3)) s.coarse().z[q] = 0.02;
+  s.exchange(1e-3);
+  const dp::FaceBalance& top = s.c->faces()[5];
+  EXPECT_EQ(top.n_inserted, 0u);
+  EXPECT_EQ(top.backlog, 24u);
+  EXPECT_EQ(top.queue.size(), 24u);
+  EXPECT_EQ(top.pending(), top.counted);
+  EXPECT_EQ(s.fine().size(), before);
+  // the backlog waits: the next transfer tries again, and places nothing either
+  s.exchange(2e-3);
+  EXPECT_EQ(top.backlog, 24u);
+  EXPECT_EQ(top.n_inserted, 0u);
+}
+
+TEST(Coupling, ExchangesHappenWhenAllLevelsStandAtTheSameTime) {
+  json doc = two_level(-9.81);
+  doc["couplings"][0]["control_steps"] = 15;  // 16 fine steps = 8 macro steps of 3.6e-5 s
+  doc["couplings"][0].erase("stress_control");
+  doc["couplings"][0].erase("velocity_control");
+  auto sim = dt::build(doc);
+  ASSERT_EQ(sim->control_macro, 8u);
+  const auto& spec = sim->couplings[0]->spec();
+  EXPECT_EQ(spec.fine_steps, 16);
+  EXPECT_EQ(spec.coarse_steps, 8);
+  // kp = 1/N, ki = 1/(N dt_f) for the stress controller; kp = 1/N_c for the velocity controller
+  EXPECT_DOUBLE_EQ(spec.stress.params["kp"].get<double>(), 1.0 / 16);
+  EXPECT_NEAR(spec.stress.params["ki"].get<double>(), 1.0 / (16 * 1.8e-5), 1e-9);
+  EXPECT_DOUBLE_EQ(spec.velocity.params["kp"].get<double>(), 1.0 / 8);
+  // What each level's clock says at every exchange (a before-hook runs just before the coupling's).
+  std::vector<std::array<double, 4>> seen;  // t, t_fine, t_coarse, fine steps
+  sim->hooks.before.push_back([&](const dp::MacroStep& m) {
+    if (m.index == 0 || m.index % 8 != 0) return;
+    auto& sds = *m.subdomains;
+    seen.push_back({m.t, sds[1]->time(), sds[0]->time(), static_cast<double>(sds[1]->steps())});
+  });
+  dp::RunOptions opt;
+  opt.output_directory = std::filesystem::temp_directory_path() / "domel_coupling_test";
+  opt.progress = false;
+  opt.max_steps = 41;
+  sim->run(opt, dt::builtin_registry());
+  std::filesystem::remove_all(opt.output_directory);
+  ASSERT_EQ(seen.size(), 5u);  // m = 8, 16, 24, 32, 40
+  EXPECT_EQ(sim->couplings[0]->control_calls(), 5u);
+  for (std::size_t k = 0; k < seen.size(); ++k) {
+    EXPECT_NEAR(seen[k][1], seen[k][0], 1e-12) << "fine level not at the exchange time";
+    EXPECT_NEAR(seen[k][2], seen[k][0], 1e-12) << "coarse level not at the exchange time";
+    EXPECT_EQ(seen[k][3], 16.0 * (k + 1));
+  }
+  EXPECT_NEAR(sim->couplings[0]->last_exchange_time(), 40 * 3.6e-5, 1e-12);
+  // and the cell averages the controllers read were sampled at that time (Coupling::control checks it)
+}
