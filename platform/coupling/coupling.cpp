@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -99,8 +100,12 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
   last_t_ = t;
   ++controls_;
   ++since_transfer_;
+  using clock = std::chrono::steady_clock;
+  auto t0 = clock::now();
   remove_escaped(fine, flow);
   count_inflow(coarse);
+  auto t1 = clock::now();
+  timing_.count += std::chrono::duration<double>(t1 - t0).count();
   bool due = since_transfer_ >= spec_.transfer_controls;
   for (int face = 0; face < kFaces && !due; ++face) {
     if (!spec_.inflow[face]) continue;
@@ -110,7 +115,10 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
           spec_.fill_target * shell_volume(face);
   }
   if (due) transfer(t, fine, walls, flow);
+  auto t2 = clock::now();
+  timing_.transfer += std::chrono::duration<double>(t2 - t1).count();
   control(t, interval, fine, coarse);
+  timing_.control += std::chrono::duration<double>(clock::now() - t2).count();
 }
 
 void Coupling::remove_escaped(Subdomain& fine, ParticleFlow& flow) {
@@ -397,7 +405,8 @@ void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& co
 }
 
 void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& flow) {
-  if (!balance_) return;
+  if (!balance_ || t <= last_row_t_) return;
+  last_row_t_ = t;
   std::vector<double> row = {t};
   MassUnits at_faces = 0;
   for (int face = 0; face < kFaces; ++face) {
@@ -475,6 +484,10 @@ nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& 
           {"removed_at_faces_kg", mass_kg(at_faces)},
           {"removed_at_outlet_kg", mass_kg(flow.accounts().at(spec_.fine).removed - at_faces)},
           {"holdup_kg", mass_kg(present)},
+          {"wall_time_s", {{"removal_and_counting", timing_.count},
+                           {"transfers", timing_.transfer},
+                           {"controllers", timing_.control},
+                           {"averaging", timing_.averaging}}},
           {"stress_control", spec_.stress.enabled ? spec_.stress.params : nlohmann::json(false)},
           {"velocity_control", spec_.velocity.enabled ? spec_.velocity.params : nlohmann::json(false)}};
 }

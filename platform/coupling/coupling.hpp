@@ -132,6 +132,14 @@ class Coupling {
   /// Close the balance file and describe the coupling for summary.json.
   nlohmann::json summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleFlow& flow);
 
+  /// Wall time spent in the coupling so far [s], by part: removal and face
+  /// counting, transfers (insertion), the controllers (views and calls),
+  /// and the run loop's sampling of the two grids (added by the run loop).
+  struct Timing {
+    double count = 0, transfer = 0, control = 0, averaging = 0;
+  };
+  Timing& timing() { return timing_; }
+
   /// Statistics of the run so far.
   std::uint64_t transfers() const { return transfers_; }
   std::uint64_t control_calls() const { return controls_; }
@@ -156,6 +164,8 @@ class Coupling {
   std::uint64_t controls_ = 0, transfers_ = 0;
   std::uint64_t since_transfer_ = 0;  ///< control intervals since the last transfer
   double last_t_ = 0;
+  double last_row_t_ = -1;
+  Timing timing_;
   double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
   std::unique_ptr<io::CsvSeries> balance_;
   std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;

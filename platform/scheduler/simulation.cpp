@@ -125,8 +125,18 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
     if (!record) return;
     const auto records = sd.contact_records();
-    for (const auto& [grid, sub] : samplers)
-      if (sub == k && grid->due(sd.steps())) grid->sample(sd.store(), records, sd.time());
+    for (std::size_t g = 0; g < samplers.size(); ++g) {
+      auto [grid, sub] = samplers[g];
+      if (sub != k || !grid->due(sd.steps())) continue;
+      if (g < grids.size()) {
+        grid->sample(sd.store(), records, sd.time());
+        continue;
+      }
+      const auto t0 = std::chrono::steady_clock::now();  // a coupling's grid: its averaging time
+      grid->sample(sd.store(), records, sd.time());
+      couplings[(g - grids.size()) / 2]->timing().averaging +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
     sd.set_record_contacts(false);
   };
   // The couplings' exchange, after the flow's own before-step work: at every
