@@ -162,8 +162,13 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
                              {"subdomain", "Subdomain (`subdomains[]`)"},
                              {"contact", "Contact model (`subdomains[].contact`)"},
                              {"insertion_model", "Inserter, platform keys (`subdomains[].insert[]`)"},
+                             {"pour", "Pour (`subdomains[].pour[]`)"},
+                             {"deletion_region", "Deletion region (`deletion_regions[]`)"},
+                             {"coupling", "Coupling between levels (`couplings[]`)"},
                              {"run", "Run (`run`)"},
-                             {"output", "Output (`output`)"}};
+                             {"output", "Output (`output`)"},
+                             {"mass_flow_plane", "Mass-flow plane (`output.mass_flow[]`)"},
+                             {"cell_grid", "Cell grid (`output.grids[]`)"}};
   for (const auto& b : blocks) {
     const json& s = root["$defs"][b[0]];
     os << "## " << b[1] << "\n\n";
@@ -180,6 +185,13 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       continue;
     }
     table(os, s, root);
+    if (std::string(b[0]) == "coupling")
+      for (const char* sub : {"region", "stress_control", "velocity_control"}) {
+        os << "### `couplings[]." << sub << "`\n\n";
+        const json& ss = s["properties"][sub];
+        if (ss.contains("description")) os << ss["description"].get<std::string>() << "\n\n";
+        table(os, ss, root);
+      }
   }
   const std::pair<uint32_t, const char*> kinds[] = {
       {DOMEL_KIND_NORMAL, "Normal-force models (`contact.normal`)"},
@@ -187,7 +199,8 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       {DOMEL_KIND_TANGENTIAL, "Tangential models (`contact.tangential`)"},
       {DOMEL_KIND_ROLLING, "Rolling-resistance models (`contact.rolling`)"},
       {DOMEL_KIND_TWISTING, "Twisting-resistance models (`contact.twisting`)"},
-      {DOMEL_KIND_INSERTION, "Insertion models (`insert[]`)"}};
+      {DOMEL_KIND_INSERTION, "Insertion models (`insert[]`)"},
+      {DOMEL_KIND_CONTROLLER, "Controller models (`couplings[].stress_control`, `couplings[].velocity_control`)"}};
   for (const auto& [kind, title] : kinds) {
     os << "## " << title << "\n\n";
     bool any = false;
@@ -196,8 +209,9 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       any = true;
       const auto& lib = registry.libraries()[m.library];
       os << "### `" << m.name << "`\n\n" << m.summary << "\n\n";
-      os << "Version " << m.version << ", library `" << lib.name << "` " << lib.version
-         << ", per-contact history: " << m.contact.history_slots << " value(s).\n\n";
+      os << "Version " << m.version << ", library `" << lib.name << "` " << lib.version;
+      if (is_contact_kind(kind)) os << ", per-contact history: " << m.contact.history_slots << " value(s)";
+      os << ".\n\n";
       if (m.schema.contains("description")) os << m.schema["description"].get<std::string>() << "\n\n";
       table(os, m.schema, root);
     }
