@@ -10,7 +10,17 @@ deletion region that counts the mass. Variants:
   silo_coarse.json  the same silo and mass at alpha = 2: 23,438 parcels of
                     5.6 mm (the mission's coarse-only case);
   silo_ci.json      D = 70 mm, outlet 20 mm (7.1 d), 15,000 particles, alpha = 1:
-                    the CI-sized case with the Beverloo check.
+                    the CI-sized case with the Beverloo check;
+and the coupled ones (docs/multilevel.md, docs/validation/multilevel.md):
+  silo_2lvl.json    silo_coarse (alpha = 2 everywhere) with a fine level
+                    (alpha = 1) in the lower quarter of the bed, around the outlet;
+  silo_3lvl.json    alpha = 4 everywhere, alpha = 2 in the lower half, alpha = 1
+                    in the lower quarter;
+  silo_ci_2lvl.json silo_ci at alpha = 2 with a fine level in its lower half
+                    (the CI-sized coupled case), and silo_ci_2lvl_nostress.json
+                    the same without the stress controller.
+Every variant has a grid "zone" with the fine region's cells, so that the
+pressure in the transition cells compares level by level.
 Each pours at a mass rate from a cylinder near the top (random sequential
 addition at volume fraction 0.22, 1.5 m/s downwards; RSA in a
 narrow cylinder jams well below its bulk limit of 0.38), opens the outlet once
@@ -35,6 +45,22 @@ VARIANTS = {
                         t_open=1.0, t_end=2.5, fit0=1.3, cells=(5, 24), grid_top=0.24, vtk=0.1),
     "silo_ci": dict(R=0.035, Do=0.020, n=15000, alpha=1, top=0.17, pour=(0.10, 0.16), rate=2.5,
                     t_open=0.5, t_end=1.15, fit0=0.65, cells=(2, 8), grid_top=0.08, vtk=0.05),
+}
+
+# The fine regions: the silo's cross-section from 4 cm below the floor (the
+# fine particles leave through the region's bottom face, which is the
+# discharge) up to z_top; cells of 30 x 30 x 15 mm (full size) or 14 mm (CI),
+# at least 2 parcel diameters of the level above.
+ZONES = {
+    "full": dict(lo=-0.04, top=0.05, cells=(5, 6)),  # the lower quarter of the ~0.20 m bed
+    "full_medium": dict(lo=-0.04, top=0.10, cells=(5, 5)),  # the lower half
+    "ci": dict(lo=-0.028, top=0.042, cells=(5, 5)),  # the lower half of the ~0.075 m bed
+}
+MULTILEVEL = {
+    # name: base variant, [(alpha, zone or None for everywhere), ...] coarsest first
+    "silo_2lvl": ("silo_coarse", [(2, None), (1, "full")]),
+    "silo_3lvl": ("silo_coarse", [(4, None), (2, "full_medium"), (1, "full")]),
+    "silo_ci_2lvl": ("silo_ci", [(2, None), (1, "ci")]),
 }
 
 
@@ -86,9 +112,48 @@ def scenario(name, R, Do, n, alpha, top, pour, rate, t_open, t_end, fit0, cells,
             "mass_flow": [{"name": "orifice", "point": [0, 0, -0.01], "normal": [0, 0, -1],
                            "rate_window": [fit0, t_end]}],
             "grids": [{"name": "bed", "min": [-R, -R, 0.0], "max": [R, R, grid_top],
-                       "cells": [cells[0], cells[0], cells[1]], "every": 15, "write_interval": 0.05}],
+                       "cells": [cells[0], cells[0], cells[1]], "every": 15, "write_interval": 0.05},
+                      zone_grid("zone", R, ZONES["ci" if R < 0.05 else "full"])],
         },
     }
+    return doc
+
+
+def zone_box(R, z):
+    return {"min": [-R, -R, z["lo"]], "max": [R, R, z["top"]], "cells": [z["cells"][0], z["cells"][0], z["cells"][1]]}
+
+
+def zone_grid(name, R, z):
+    return dict(name=name, **zone_box(R, z), every=15, write_interval=0.05)
+
+
+def multilevel(name, base, levels, stress=True):
+    """The base silo at the coarsest level's alpha, plus one finer subdomain
+    per further level, each coupled to the one before it on its zone."""
+    v = dict(VARIANTS[base])
+    v["alpha"] = levels[0][0]
+    doc = scenario(name, **v)
+    R = v["R"]
+    coarse = doc["subdomains"][0]
+    coarse["name"] = f"alpha{levels[0][0]}"
+    doc["description"] = (f"Multi-level silo (scenarios/silo/make_silo.py): {base} with levels "
+                          + ", ".join(f"alpha = {a}" + (f" below z = {ZONES[z]['top']} m" if z else " everywhere")
+                                      for a, z in levels) + ", coupled level by level (docs/multilevel.md).")
+    doc["couplings"] = []
+    for k in range(1, len(levels)):
+        alpha, zone = levels[k]
+        doc["subdomains"].append({
+            "name": f"alpha{alpha}", "material": "glass", "coarse_grain": alpha,
+            "contact": coarse["contact"], "time_step": 1.8e-5 * alpha, "impact_velocity": 1.0})
+        c = {"name": f"zone{k}", "coarse": f"alpha{levels[k - 1][0]}", "fine": f"alpha{alpha}",
+             "region": zone_box(R, ZONES[zone]), "inflow_faces": ["+z"], "grid_interval": 0.05}
+        if not stress:
+            c["stress_control"] = {"enabled": False}
+        doc["couplings"].append(c)
+    finest = doc["subdomains"][-1]["name"]
+    doc["output"]["mass_flow"][0]["subdomain"] = finest  # the discharge at the fine level's outlet
+    doc["output"]["grids"][0]["subdomain"] = coarse["name"]
+    doc["output"]["grids"][1]["subdomain"] = finest
     return doc
 
 
@@ -98,3 +163,10 @@ if __name__ == "__main__":
             json.dump(scenario(name, **v), f, indent=2)
             f.write("\n")
         print("wrote", name + ".json")
+    for name, (base, levels) in MULTILEVEL.items():
+        variants = [(name, True)] + ([(name + "_nostress", False)] if name == "silo_ci_2lvl" else [])
+        for out, stress in variants:
+            with open(os.path.join(HERE, out + ".json"), "w") as f:
+                json.dump(multilevel(out, base, levels, stress), f, indent=2)
+                f.write("\n")
+            print("wrote", out + ".json")
