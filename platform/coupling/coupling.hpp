@@ -101,6 +101,8 @@ struct FaceBalance {
   std::uint64_t backlog = 0;           ///< particles that could not be placed at the last transfer
   int growing = 0;                     ///< consecutive transfers with a growing backlog
   bool warned = false;
+  bool warned_fill = false;
+  double volume_open = 0;              ///< [m^3] solid volume counted since the last transfer
   MassUnits pending() const { return counted - inserted; }
 };
 

@@ -447,10 +447,17 @@ void scan_couplings(Build& b) {
   }
 }
 
-/// Bounding box of what bounds a top-level domain: the finite walls, the
-/// pour, insertion and deletion regions. False when nothing is finite.
+/// Bounding box of a top-level domain: when the walls enclose a finite
+/// region (a cylinder, a cone or a mesh), their bounding box together with
+/// the pour, insertion and deletion regions (particles fall out of an outlet
+/// into a deletion region). False with planes alone: the domain is unbounded.
 bool domain_bounds(Build& b, double lo[3], double hi[3]) {
   bool any = false;
+  bool enclosed = false;
+  for (const auto& w : b.sim.walls)
+    enclosed = enclosed || w.shape == WallPrimitive::Shape::cylinder_inside ||
+               w.shape == WallPrimitive::Shape::cone_inside || w.shape == WallPrimitive::Shape::mesh;
+  if (!enclosed) return false;
   auto grow = [&](const double a[3], const double z[3]) {
     for (int k = 0; k < 3; ++k) {
       lo[k] = any ? std::min(lo[k], a[k]) : a[k];
@@ -729,7 +736,9 @@ void build_couplings(Build& b) {
                 {"ki", blk.contains("ki") ? blk["ki"].get<double>() : 1.0 / (s.fine_steps * dt_f)},
                 {"layer_diameters", blk["layer_diameters"]},
                 {"fade_fraction", blk["fade_fraction"]},
-                {"velocity_limit", blk["velocity_limit"]}};
+                {"velocity_limit", blk["velocity_limit"]},
+                // one fine step ahead: the reference's per-step prediction, without the contact force the view lacks
+                {"limit_horizon", dt_f}};
       controller("stress_control", s.stress, p);
     }
     {

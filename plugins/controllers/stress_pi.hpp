@@ -22,7 +22,8 @@
 //   u_k < 0: undo the integration, no force (push inward only)
 //   F = dir_k u_k on each fine particle of c in the forcing layer (full over
 //   the outer 1 - fade_fraction of it, sin^2 ramp to 0 over the inner part),
-//   scaled per particle by the velocity limiter (common.hpp)
+//   scaled per particle by the velocity limiter (common.hpp), which predicts
+//   v + h F/m over the horizon h (limit_horizon, default T)
 //   mean applied |F| per controlled particle < u_k/2: undo the integration
 // Units: PV, SP, e, u in N (a mean normal force per particle), I in N s.
 #pragma once
@@ -94,7 +95,9 @@ class StressPi {
     "fade_fraction": { "type": "number", "minimum": 0, "maximum": 1, "default": 0.125, "x-unit": "1",
                        "description": "inner share of the forcing layer over which the force fades to zero with a sin^2 ramp" },
     "velocity_limit": { "type": "number", "minimum": 0, "default": 0.2, "x-unit": "1",
-                        "description": "relative velocity limit r: a pushed particle's velocity, predicted over the control interval, stays within the coarse cell's particle velocity range widened by r (0: no limit)" }
+                        "description": "relative velocity limit r: a pushed particle's velocity, predicted over the limit horizon, stays within the coarse cell's particle velocity range widened by r (0: no limit)" },
+    "limit_horizon": { "type": "number", "exclusiveMinimum": 0, "x-unit": "s",
+                       "description": "time over which the velocity limiter predicts the force's effect, v + horizon F/m (default: the whole control interval). The reference predicts one (half) step with the contact force included; a particle pressed into a bed has its push balanced by its contacts, which this view does not carry, so a horizon of a whole interval throttles the push far below what the bed needs. domel's couplings pass the fine time step" }
   },
   "required": ["cells", "directions", "kp", "ki"],
   "additionalProperties": false
@@ -107,10 +110,13 @@ class StressPi {
         kd_(non_negative(p.json(), "kd", kName, false, 0.0)),
         layer_diameters_(non_negative(p.json(), "layer_diameters", kName, false, 1.4)),
         fade_fraction_(non_negative(p.json(), "fade_fraction", kName, false, 0.125)),
-        velocity_limit_(non_negative(p.json(), "velocity_limit", kName, false, 0.2)) {
+        velocity_limit_(non_negative(p.json(), "velocity_limit", kName, false, 0.2)),
+        limit_horizon_(non_negative(p.json(), "limit_horizon", kName, false, 0.0)) {
     const std::string who = std::string(kName) + ": ";
     if (!(layer_diameters_ > 0.0)) throw sdk::ParameterError(who + "'layer_diameters' must be > 0");
     if (fade_fraction_ > 1.0) throw sdk::ParameterError(who + "'fade_fraction' must lie in [0, 1]");
+    if (p.json().contains("limit_horizon") && !(limit_horizon_ > 0.0))
+      throw sdk::ParameterError(who + "'limit_horizon' must be > 0");
     directions_ = parse_directions(p.json(), cells_.size());
     state_.resize(cells_.size());
   }
@@ -124,6 +130,7 @@ class StressPi {
     members_.build(pa, cells_, ga.n_cells);
 
     const double T = step.interval;
+    const double horizon = limit_horizon_ > 0.0 ? limit_horizon_ : T;  // the velocity limiter's look-ahead
     const double volume = ga.spacing[0] * ga.spacing[1] * ga.spacing[2];  // V_c
     // physics.md §5.3 "Where the force acts": used = 1.4 d_max, d_max the
     // largest fine diameter (the reference's 2 r_max cg_a/cg_max); over the
@@ -214,7 +221,7 @@ class StressPi {
           double f = static_cast<double>(dir) * u * w;
           if (velocity_limit_ > 0.0) {
             const double m = pa.mass[i];
-            f *= m > 0.0 ? limit_factor(vel[k][i], T * f / m, bounds) : 0.0;
+            f *= m > 0.0 ? limit_factor(vel[k][i], horizon * f / m, bounds) : 0.0;
           }
           force[k][i] += f;
           applied += std::fabs(f);
@@ -294,6 +301,7 @@ class StressPi {
   std::vector<std::array<int, 3>> directions_;
   double kp_, ki_, kd_;
   double layer_diameters_, fade_fraction_, velocity_limit_;
+  double limit_horizon_;  ///< 0: the control interval
   std::vector<StressPiCellState> state_;
   CellMembers members_;
 };

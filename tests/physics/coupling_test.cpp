@@ -226,3 +226,46 @@ TEST(Coupling, ExchangesHappenWhenAllLevelsStandAtTheSameTime) {
   EXPECT_NEAR(sim->couplings[0]->last_exchange_time(), 40 * 3.6e-5, 1e-12);
   // and the cell averages the controllers read were sampled at that time (Coupling::control checks it)
 }
+
+TEST(Coupling, NestsThreeLevels) {
+  // alpha 4 everywhere (a falling lattice block), alpha 2 in the lower half,
+  // alpha 1 in the lower quarter: material must pass 4 -> 2 -> 1.
+  json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
+  doc["gravity"] = {0, 0, -9.81};
+  auto level = [&](const char* name, double alpha) {
+    return json{{"name", name}, {"material", "m"}, {"coarse_grain", alpha}, {"contact", dt::hertz_mindlin()},
+                {"time_step", 1.8e-5 * alpha}};
+  };
+  json top = level("a4", 4);
+  top["insert"] = {{{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.05}, {"velocity", {0, 0, -3}},
+                    {"region", {{"box", {{"min", {0, 0, 0.062}}, {"max", {0.12, 0.12, 0.12}}}}}}}};
+  doc["subdomains"] = {top, level("a2", 2), level("a1", 1)};
+  auto coupling = [](const char* name, const char* coarse, const char* fine, double z_top) {
+    return json{{"name", name},
+                {"coarse", coarse},
+                {"fine", fine},
+                {"region", {{"min", {0, 0, 0}}, {"max", {0.12, 0.12, z_top}}, {"cells", {2, 2, 1}}}},
+                {"inflow_faces", {"+z"}},
+                {"transfer_max_steps", 16}};
+  };
+  doc["couplings"] = {coupling("upper", "a4", "a2", 0.06), coupling("lower", "a2", "a1", 0.03)};
+  auto sim = dt::build(doc);
+  EXPECT_EQ(sim->control_macro, 4u);  // 15 fine steps asked, 4 per macro step of 7.2e-5 s
+  dp::RunOptions opt;
+  opt.output_directory = std::filesystem::temp_directory_path() / "domel_coupling_nest_test";
+  opt.progress = false;
+  opt.max_steps = 240;  // 17 ms: the block reaches the lower region
+  sim->run(opt, dt::builtin_registry());
+  std::filesystem::remove_all(opt.output_directory);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(sim->flow.residual(k, sim->subdomains[k]->store()), 0) << k;
+  const auto& upper = sim->couplings[0]->faces()[5];
+  const auto& lower = sim->couplings[1]->faces()[5];
+  EXPECT_GT(upper.parcels, 0u);
+  EXPECT_GT(upper.n_inserted, 0u);
+  EXPECT_GT(lower.parcels, 0u);  // alpha-2 particles, themselves inserted by "upper", crossed into "lower"
+  EXPECT_GT(lower.n_inserted, 0u);
+  EXPECT_EQ(lower.n_inserted + lower.queue.size(), 8 * lower.parcels);
+  // each finer level lives only in its region (checked at the last control interval, before the last steps)
+  const auto& a1 = sim->subdomains[2]->store();
+  for (std::size_t q = 0; q < a1.size(); ++q) EXPECT_LT(a1.z[q], 0.03 + 0.01);
+}

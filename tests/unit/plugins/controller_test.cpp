@@ -404,6 +404,29 @@ TEST(StressPi, VelocityLimitLandsExactlyOnTheBound) {
   EXPECT_TRUE(close(d.L.fine.p.fz[d.p0], -u));  // dv = -3.2e-3: v* = 0.0968 > -0.6
 }
 
+// Guards limit_horizon: the limiter predicts v + h F/m over the given horizon
+// instead of the whole interval (domel's couplings pass the fine time step).
+TEST(StressPi, VelocityLimitPredictsOverTheHorizon) {
+  StressCase c;
+  c.L.coarse.grid.u_min[2][2] = -0.5;
+  c.L.coarse.grid.u_max[2][2] = 0.1;
+  Particles& f = c.L.fine.p;
+  // P0: m = 1e-5 kg, vz = -0.59, horizon T/10: unlimited dv = -0.032 m/s would reach -0.622;
+  // lambda = (-0.6 + 0.59)/(-0.032) = 0.3125 (ten times the whole-interval lambda 0.03125 above)
+  f.m[c.p0] = 1e-5;
+  f.vz[c.p0] = -0.59;
+  json p = StressCase::params();
+  p["velocity_limit"] = 0.2;
+  p["limit_horizon"] = StressCase::kT / 10;
+  StressPi model{Params(p)};
+  model.control(c.L.step(StressCase::kT));
+  EXPECT_TRUE(close(f.fz[c.p0], -StressCase::u1() * 0.3125, 1e-9));
+  EXPECT_NEAR(f.vz[c.p0] + StressCase::kT / 10 * f.fz[c.p0] / f.m[c.p0], -0.6, 1e-14);
+  json bad = StressCase::params();
+  bad["limit_horizon"] = 0.0;
+  EXPECT_THROW(StressPi{Params(bad)}, domel::sdk::ParameterError);
+}
+
 // Guards the a-posteriori anti-windup: mean applied force per pushed particle < u/2 undoes the integration.
 TEST(StressPi, APosterioriAntiWindup) {
   json p = StressCase::params();
