@@ -37,7 +37,7 @@ def level(name, alpha):
 
 
 def pour():
-    return [{"insert": {"model": "random", "diameter": D, "volume_fraction": 0.2,
+    return [{"insert": {"model": "random", "diameter": D, "volume_fraction": 0.05,
                         "region": {"box": {"min": [-0.02 + D, -0.02 + D, 0.10], "max": [0.02 - D, 0.0 - D, 0.12]}}},
              "mass_rate": 0.087, "interval": 5e-4}]
 
