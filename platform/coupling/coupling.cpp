@@ -88,7 +88,7 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
   if (spec_.grid_interval > 0) {
     vtk_fine_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_fine");
     vtk_coarse_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_coarse");
-    next_grid_file_ = spec_.grid_interval;
+    grid_files_ = Interval(spec_.grid_interval, spec_.grid_interval, macro_step_of(subdomains));
   }
 }
 
@@ -453,8 +453,8 @@ void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& fl
 
 void Coupling::write_grids(double t, bool final) {
   if (!vtk_fine_) return;
-  if (!final && t < next_grid_file_ - 1e-12) return;
-  while (next_grid_file_ <= t + 1e-12) next_grid_file_ += spec_.grid_interval;
+  if (!final && !grid_files_.due(t)) return;
+  grid_files_.advance(t);
   if (fine_grid_->samples_pending() > 0) vtk_fine_->write(t, *fine_grid_, fine_grid_->mean_since_last_take());
   if (coarse_grid_->samples_pending() > 0)
     vtk_coarse_->write(t, *coarse_grid_, coarse_grid_->mean_since_last_take());

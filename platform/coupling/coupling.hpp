@@ -28,6 +28,7 @@
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scheduler/particle_flow.hpp"
+#include "scheduler/schedule.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <nlohmann/json.hpp>
@@ -171,7 +172,7 @@ class Coupling {
   double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
   std::unique_ptr<io::CsvSeries> balance_;
   std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;
-  double next_grid_file_ = 0;
+  Interval grid_files_;  ///< the grid files, every grid_interval (never due when 0)
   // scratch of the controller views
   std::vector<std::uint32_t> cell_f_, cell_c_, count_f_, count_c_;
   std::vector<double> stress_f_, stress_c_;

@@ -447,6 +447,19 @@ void scan_couplings(Build& b) {
   }
 }
 
+/// True when `level` is a finer level of `ancestor` through the parent map
+/// of /couplings (a loop in the map ends the walk).
+bool descends_from(const Build& b, const std::string& level, const std::string& ancestor) {
+  std::string up = level;
+  for (std::size_t hops = 0; hops <= b.parent.size(); ++hops) {
+    const auto it = b.parent.find(up);
+    if (it == b.parent.end()) return false;
+    up = it->second.first;
+    if (up == ancestor) return true;
+  }
+  return false;
+}
+
 /// Bounding box of a top-level domain: when the walls enclose a finite
 /// region (a cylinder, a cone or a mesh), their bounding box together with
 /// the pour, insertion and deletion regions (particles fall out of an outlet
@@ -539,15 +552,9 @@ void build_couplings(Build& b) {
       continue;
     }
     // a cycle: the coarse level descends from the fine one
-    for (std::string up = names[s.coarse]; b.parent.count(up) != 0;) {
-      up = b.parent[up].first;
-      if (up == names[s.fine]) {
-        b.ck.add(base + "/coarse", "the couplings form a loop: '" + names[s.coarse] + "' is itself a finer level of '" +
-                                       names[s.fine] + "'");
-        break;
-      }
-      if (up == names[s.coarse]) break;
-    }
+    if (descends_from(b, names[s.coarse], names[s.fine]))
+      b.ck.add(base + "/coarse", "the couplings form a loop: '" + names[s.coarse] + "' is itself a finer level of '" +
+                                     names[s.fine] + "'");
     if (b.ck.diags.size() > before) continue;
     // region and cells
     const json& rj = cj["region"];
@@ -600,17 +607,7 @@ void build_couplings(Build& b) {
     // two fine regions that overlap (a nested region lies inside its parent's, which is fine)
     for (std::size_t h = 0; h < specs.size(); ++h) {
       const CouplingSpec& o = specs[h];
-      bool nested = false;
-      for (std::string up = names[s.fine]; b.parent.count(up) != 0 && !nested;) {
-        up = b.parent[up].first;
-        nested = up == names[o.fine];
-        if (up == names[s.fine]) break;
-      }
-      for (std::string up = names[o.fine]; b.parent.count(up) != 0 && !nested;) {
-        up = b.parent[up].first;
-        nested = up == names[s.fine];
-        if (up == names[o.fine]) break;
-      }
+      const bool nested = descends_from(b, names[s.fine], names[o.fine]) || descends_from(b, names[o.fine], names[s.fine]);
       bool overlap = true;
       for (int a = 0; a < 3; ++a) overlap = overlap && s.grid.lo[a] < o.grid.hi[a] && o.grid.lo[a] < s.grid.hi[a];
       if (overlap && !nested)

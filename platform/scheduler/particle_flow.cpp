@@ -118,8 +118,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
     const std::size_t k = st.size() - 1;
     st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
     p.inserted_mass += st.mass[k];
-    accounts_[p.subdomain].inserted += mass_units(st.mass[k]);
-    ++accounts_[p.subdomain].n_inserted;
+    count_inserted(p.subdomain, st.mass[k]);
     ++taken;
   }
   sd.apply_body_forces(st.size() - taken, st.size());  // their first half kick sees their body forces
@@ -183,9 +182,7 @@ void ParticleFlow::delete_particles(std::vector<std::unique_ptr<Subdomain>>& sub
         any = true;
         ++d.removed;
         d.removed_mass += s.mass[q];
-        accounts_[k].removed += mass_units(s.mass[q]);
-        ++accounts_[k].n_removed;
-        for (auto& pl : planes) pl.side[k].erase(s.id[q]);
+        count_removed(k, s.id[q], s.mass[q]);
         break;  // a particle in two regions is counted by the first
       }
     }

@@ -110,32 +110,32 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     grid_files.emplace_back(g.spec.write_interval, g.spec.write_interval, macro);
   }
   // Every grid that samples a subdomain: the output grids and both levels of each coupling.
-  std::vector<std::pair<CellGrid*, std::size_t>> samplers;
-  for (std::size_t g = 0; g < grids.size(); ++g) samplers.emplace_back(grids[g].get(), grid_setups[g].subdomain);
+  // A coupling's grids also add their sampling time to the coupling's clock.
+  struct Sampler {
+    CellGrid* grid;
+    std::size_t subdomain;
+    double* seconds;  ///< where the sampling time goes; null for the output grids
+  };
+  std::vector<Sampler> samplers;
+  for (std::size_t g = 0; g < grids.size(); ++g) samplers.push_back({grids[g].get(), grid_setups[g].subdomain, nullptr});
   for (auto& c : couplings) {
     c->start(subdomains, walls, out);
-    samplers.emplace_back(&c->fine_grid(), c->spec().fine);
-    samplers.emplace_back(&c->coarse_grid(), c->spec().coarse);
+    samplers.push_back({&c->fine_grid(), c->spec().fine, &c->timing().averaging});
+    samplers.push_back({&c->coarse_grid(), c->spec().coarse, &c->timing().averaging});
   }
   auto step_subdomain = [&](std::size_t k) {
     Subdomain& sd = *subdomains[k];
     bool record = false;
-    for (const auto& [grid, sub] : samplers) record = record || (sub == k && grid->due(sd.steps() + 1));
+    for (const auto& s : samplers) record = record || (s.subdomain == k && s.grid->due(sd.steps() + 1));
     sd.set_record_contacts(record);
     sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
     if (!record) return;
     const auto records = sd.contact_records();
-    for (std::size_t g = 0; g < samplers.size(); ++g) {
-      auto [grid, sub] = samplers[g];
-      if (sub != k || !grid->due(sd.steps())) continue;
-      if (g < grids.size()) {
-        grid->sample(sd.store(), records, sd.time());
-        continue;
-      }
-      const auto t0 = std::chrono::steady_clock::now();  // a coupling's grid: its averaging time
-      grid->sample(sd.store(), records, sd.time());
-      couplings[(g - grids.size()) / 2]->timing().averaging +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (const auto& s : samplers) {
+      if (s.subdomain != k || !s.grid->due(sd.steps())) continue;
+      const auto t0 = std::chrono::steady_clock::now();
+      s.grid->sample(sd.store(), records, sd.time());
+      if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     sd.set_record_contacts(false);
   };
