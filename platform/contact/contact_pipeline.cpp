@@ -3,6 +3,9 @@
 #include "contact/contact_pipeline.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <new>
 
 namespace domel::platform {
 
@@ -11,17 +14,28 @@ ContactPipeline::ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlo
   for (std::size_t s = 0; s < kSlotCount; ++s) {
     offset_[s] = history_stride_;
     if (slots_[s]) history_stride_ += slots_[s]->history_slots();
+    if (slots_[s] && slots_[s]->reads_masses()) reads_masses_ = true;
   }
   main_ = make_workspace();
 }
 
+void ContactPipeline::Workspace::AlignedFree::operator()(void* p) const { std::free(p); }
+
 ContactPipeline::Workspace::Workspace(uint32_t history_stride) {
   const std::size_t n = kBatchSize;
-  for (auto* v : {&buf.overlap, &buf.nx, &buf.ny, &buf.nz, &buf.r_eff, &buf.m_eff, &buf.radius_i, &buf.radius_j,
-                  &buf.mass_i, &buf.mass_j, &buf.vn, &buf.vtx, &buf.vty, &buf.vtz, &buf.wx, &buf.wy, &buf.wz, &buf.fn_elastic, &buf.kn,
-                  &buf.kn_tangent, &buf.contact_radius, &buf.fn_damping, &buf.eta_n, &buf.fn, &buf.ftx, &buf.fty,
-                  &buf.ftz, &buf.tqx, &buf.tqy, &buf.tqz, &buf.rolling_stiffness, &buf.rolling_damping})
-    v->assign(n, 0.0);
+  const std::initializer_list<BatchArray*> arrays = {
+      &buf.overlap, &buf.nx, &buf.ny, &buf.nz, &buf.r_eff, &buf.m_eff, &buf.radius_i, &buf.radius_j,
+      &buf.mass_i, &buf.mass_j, &buf.vn, &buf.vtx, &buf.vty, &buf.vtz, &buf.wx, &buf.wy, &buf.wz, &buf.fn_elastic,
+      &buf.kn, &buf.kn_tangent, &buf.contact_radius, &buf.fn_damping, &buf.eta_n, &buf.fn, &buf.ftx, &buf.fty,
+      &buf.ftz, &buf.tqx, &buf.tqy, &buf.tqz, &buf.rolling_stiffness, &buf.rolling_damping};
+  static_assert(kArrayStride % 64 == 0, "arrays start on cache lines");
+  const std::size_t bytes = arrays.size() * kArrayStride;
+  block_.reset(static_cast<double*>(std::aligned_alloc(64, bytes)));
+  if (!block_) throw std::bad_alloc();
+  std::memset(block_.get(), 0, bytes);
+  std::size_t k = 0;
+  for (BatchArray* a : arrays)
+    a->p = reinterpret_cast<double*>(reinterpret_cast<char*>(block_.get()) + kArrayStride * k++);
   buf.history.assign(n * std::max<uint32_t>(history_stride, 1), 0.0);
   buf.pair_of.assign(n, nullptr);
 

@@ -6,7 +6,8 @@
 // the per-contact history; the pipeline lays the slices out in one stride.
 //
 // Callers fill the input arrays of a Workspace for up to kBatchSize contacts
-// (and their history rows, masses included: mass_j = 0 for a wall), call
+// (and their history rows; the masses when reads_masses(): mass_j = 0 for a
+// wall), call
 // evaluate(workspace, pair, dt, n) when every contact shares one material
 // pair (today always: the batch then carries the pair once, abi.h), or
 // evaluate(workspace, dt, n) after filling buf.pair_of per contact, grouped
@@ -40,25 +41,50 @@ class ContactPipeline {
   /// A rolling or twisting model fills the torque couples (tqx, tqy, tqz);
   /// without one they stay zero.
   bool has_torque() const { return slots_[static_cast<int>(Slot::rolling)] || slots_[static_cast<int>(Slot::twisting)]; }
+  /// Whether some stage reads the batch's mass_i/mass_j; when none does,
+  /// the gathers leave them unfilled (abi.h, DOMEL_CONTACT_IGNORES_MASSES).
+  bool reads_masses() const { return reads_masses_; }
 
+  /// One per-contact array of a batch: kBatchSize doubles inside the
+  /// workspace's block.
+  struct BatchArray {
+    double* p = nullptr;
+    double* data() const { return p; }
+    double& operator[](std::size_t c) const { return p[c]; }
+    double* begin() const { return p; }
+    double* end() const { return p + kBatchSize; }
+  };
   /// Buffers of one batch (structure of arrays, capacity kBatchSize).
   struct Buffers {
-    std::vector<double> overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, mass_i, mass_j, vn, vtx, vty, vtz, wx,
-        wy, wz;
-    std::vector<double> fn_elastic, kn, kn_tangent, contact_radius, fn_damping, eta_n, fn;
-    std::vector<double> ftx, fty, ftz, tqx, tqy, tqz;
-    std::vector<double> rolling_stiffness, rolling_damping;
+    BatchArray overlap, nx, ny, nz, r_eff, m_eff, radius_i, radius_j, mass_i, mass_j, vn, vtx, vty, vtz, wx, wy, wz;
+    BatchArray fn_elastic, kn, kn_tangent, contact_radius, fn_damping, eta_n, fn;
+    BatchArray ftx, fty, ftz, tqx, tqy, tqz;
+    BatchArray rolling_stiffness, rolling_damping;
     std::vector<double> history;  ///< kBatchSize * history_stride
     std::vector<const domel_pair_v2*> pair_of;  ///< per contact, for a batch of several pairs
   };
-  /// One thread's batch buffers and the ABI view of them.
+  /// One thread's batch buffers and the ABI view of them. The per-contact
+  /// arrays lie in one cache-line-aligned block, kArrayStride bytes apart:
+  /// 2 KiB of data plus 3 cache lines, so that no two arrays start at the
+  /// same address modulo 4 KiB (35 and 64 are coprime). Element c of any two
+  /// arrays then never shares the low 12 address bits, which the CPU's
+  /// store-to-load check compares first (4K aliasing: a load from one array
+  /// stalls behind a store to another at the same offset, as separately
+  /// allocated 2 KiB vectors can land).
   class Workspace {
    public:
+    static constexpr std::size_t kArrayStride = kBatchSize * sizeof(double) + 3 * 64;
     explicit Workspace(uint32_t history_stride);
     Workspace(const Workspace&) = delete;
     Workspace& operator=(const Workspace&) = delete;
     Buffers buf;
     domel_contact_batch_v2 batch{};
+
+   private:
+    struct AlignedFree {
+      void operator()(void* p) const;
+    };
+    std::unique_ptr<double, AlignedFree> block_;
   };
   std::unique_ptr<Workspace> make_workspace() const { return std::make_unique<Workspace>(history_stride_); }
 
@@ -75,6 +101,7 @@ class ContactPipeline {
   std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots_;
   std::array<uint32_t, kSlotCount> offset_{};
   uint32_t history_stride_ = 0;
+  bool reads_masses_ = false;
   std::unique_ptr<Workspace> main_;
   void run_stages(Workspace& ws, double dt, uint32_t n) const;
 };

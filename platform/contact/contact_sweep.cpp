@@ -52,10 +52,11 @@ struct Slots {
 /// The gather, shared by pairs and walls: slot q of the batch from the
 /// contact's geometry and the relative velocity (rx, ry, rz) of its contact
 /// points, split into the normal approach speed and the tangential part.
-/// A wall is partner j with rj = 0 and mj = 0.
-inline void fill_slot(const Slots& b, uint32_t q, double delta, double nx, double ny, double nz, double ri,
-                      double rj, double r_eff, double mi, double mj, double m_eff, double rx, double ry, double rz,
-                      double wx, double wy, double wz) {
+/// A wall is partner j with rj = 0 and mj = 0. The masses are stored only
+/// when a stage reads them (ContactPipeline::reads_masses).
+inline void fill_slot(const Slots& b, bool masses, uint32_t q, double delta, double nx, double ny, double nz,
+                      double ri, double rj, double r_eff, double mi, double mj, double m_eff, double rx, double ry,
+                      double rz, double wx, double wy, double wz) {
   const double vdotn = rx * nx + ry * ny + rz * nz;
   b.overlap[q] = delta;
   b.nx[q] = nx; b.ny[q] = ny; b.nz[q] = nz;
@@ -63,8 +64,10 @@ inline void fill_slot(const Slots& b, uint32_t q, double delta, double nx, doubl
   b.radius_j[q] = rj;
   b.r_eff[q] = r_eff;
   b.m_eff[q] = m_eff;
-  b.mass_i[q] = mi;
-  b.mass_j[q] = mj;
+  if (masses) {
+    b.mass_i[q] = mi;
+    b.mass_j[q] = mj;
+  }
   b.vn[q] = -vdotn;
   b.vtx[q] = rx - vdotn * nx; b.vty[q] = ry - vdotn * ny; b.vtz[q] = rz - vdotn * nz;
   b.wx[q] = wx; b.wy[q] = wy; b.wz[q] = wz;
@@ -108,7 +111,7 @@ inline void add(const ForceAccumulator& a, uint32_t k, double fx, double fy, dou
   a.tx[k] += tx; a.ty[k] += ty; a.tz[k] += tz;
 }
 
-template <bool kZoned, bool kTorque>
+template <bool kZoned, bool kTorque, bool kMasses>
 void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, ContactScratch& ts, std::size_t own_lo,
                 std::size_t own_hi, const ForceAccumulator& own, const ForceAccumulator& shared) {
   const ParticleStore& s = *sw.store;
@@ -179,7 +182,7 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       point_velocity(pvx[j], pvy[j], pvz[j], wjx, wjy, wjz, cj, nx, ny, nz, vjx, vjy, vjz);
       // one division for R* and the overlap ratio
       const double mi = pm[i], mj = pm[j];
-      fill_slot(slots, q, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, mi, mj, mi * mj / (mi + mj),
+      fill_slot(slots, kMasses, q, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, mi, mj, mi * mj / (mi + mj),
                 vix - vjx, viy - vjy, viz - vjz, wix - wjx, wiy - wjy, wiz - wjz);
       copy_row(list_history + static_cast<std::size_t>(le) * stride, b_hist + static_cast<std::size_t>(q) * stride,
                stride);
@@ -234,9 +237,17 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
 
 }  // namespace
 
-PairRangeFn pair_kernel(bool has_torque, bool zoned) {
-  if (has_torque) return zoned ? &pair_range<true, true> : &pair_range<false, true>;
-  return zoned ? &pair_range<true, false> : &pair_range<false, false>;
+namespace {
+template <bool kMasses>
+PairRangeFn pair_kernel_of(bool has_torque, bool zoned) {
+  if (has_torque) return zoned ? &pair_range<true, true, kMasses> : &pair_range<false, true, kMasses>;
+  return zoned ? &pair_range<true, false, kMasses> : &pair_range<false, false, kMasses>;
+}
+}  // namespace
+
+PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned) {
+  return pipeline.reads_masses() ? pair_kernel_of<true>(pipeline.has_torque(), zoned)
+                                 : pair_kernel_of<false>(pipeline.has_torque(), zoned);
 }
 
 void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std::size_t last) {
@@ -244,6 +255,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
   auto& buf = ts.ws->buf;
   const Slots slots(buf);
   const uint32_t stride = sw.pipeline->history_stride();
+  const bool masses = sw.pipeline->reads_masses();
   std::size_t contacts = 0;
   double max_ratio = 0.0;
   for (std::size_t w = 0; w < sw.lists->size(); ++w) {
@@ -297,7 +309,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         wall.surface_velocity(sw.wall_time, s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
         rx -= ux; ry -= uy; rz -= uz;
       }
-      fill_slot(slots, c, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], 0.0, s.mass[i], rx, ry, rz,
+      fill_slot(slots, masses, c, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], 0.0, s.mass[i], rx, ry, rz,
                 s.wx[i], s.wy[i], s.wz[i]);
       copy_row(list.history.data() + e * stride, buf.history.data() + c * stride, stride);
       list.touching[e] = 1;

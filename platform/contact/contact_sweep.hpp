@@ -75,8 +75,9 @@ struct PairSweep {
 using PairRangeFn = void (*)(const PairSweep&, std::size_t first, std::size_t last, ContactScratch& ts,
                              std::size_t own_lo, std::size_t own_hi, const ForceAccumulator& own,
                              const ForceAccumulator& shared);
-/// The pair_range instance for a pipeline (with or without a couple), with or without zones.
-PairRangeFn pair_kernel(bool has_torque, bool zoned);
+/// The pair_range instance for a pipeline (with or without a couple, with or
+/// without the masses its stages read), with or without zones.
+PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned);
 
 /// The inputs of the wall sweep of one force evaluation.
 struct WallSweep {

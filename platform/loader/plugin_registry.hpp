@@ -107,6 +107,9 @@ class ModelInstance {
   const RegisteredModel& model() const { return *model_; }
   void* handle() const { return handle_; }
   uint32_t history_slots() const { return model_->contact.history_slots; }
+  /// Whether the contact stage reads the batch's mass_i/mass_j (it did not
+  /// declare DOMEL_CONTACT_IGNORES_MASSES; a 2.0 table always reads them).
+  bool reads_masses() const { return (model_->contact.flags & DOMEL_CONTACT_IGNORES_MASSES) == 0; }
   /// "rolling model 'epsd' (library 'third_party_rolling') at <where>": the prefix of its messages.
   const std::string& context() const;
   /// The last error the plugin reported through the host's error service ("" if none).

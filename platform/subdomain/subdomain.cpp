@@ -393,7 +393,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
     ts.pair_max_ratio = 0.0;
   }
   if (nt == 1) {
-    const PairRangeFn range = pair_kernel(pipeline_->has_torque(), false);
+    const PairRangeFn range = pair_kernel(*pipeline_, false);
     range(sweep, 0, nlist_.near_size(), scratch_[0], 0, s.size(), direct, direct);
     if (far) range(sweep, nlist_.near_size(), nlist_.size(), scratch_[0], 0, s.size(), direct, direct);
   } else {
@@ -410,7 +410,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
       const ForceAccumulator shared = t > 0 ? partition_.private_accumulator(t, n) : direct;
       const ForcePartition::ThreadForces& tf = partition_.thread(t);
       // thread 0 adds all its forces into the store
-      const PairRangeFn range = pair_kernel(pipeline_->has_torque(), t > 0);
+      const PairRangeFn range = pair_kernel(*pipeline_, t > 0);
       const auto [near_first, near_last] = partition_.entries(0, t);
       range(sweep, near_first, near_last, ts, tf.own_lo, tf.own_hi, direct, shared);
       if (far) {

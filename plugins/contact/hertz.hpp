@@ -15,6 +15,7 @@ namespace domel::plugins::contact {
 class Hertz {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_NORMAL;
+  static constexpr bool kReadsMasses = false;  // abi.h: DOMEL_CONTACT_IGNORES_MASSES
   static constexpr const char* kName = "hertz";
   static constexpr const char* kVersion = "1.0.0";
   static constexpr const char* kSummary =

@@ -15,6 +15,7 @@ namespace domel::plugins::contact {
 class Mindlin {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_TANGENTIAL;
+  static constexpr bool kReadsMasses = false;  // abi.h: DOMEL_CONTACT_IGNORES_MASSES
   static constexpr const char* kName = "mindlin";
   static constexpr const char* kVersion = "1.0.0";
   static constexpr const char* kSummary =

@@ -21,6 +21,7 @@ namespace domel::plugins::contact {
 class RestitutionDamping {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_DAMPING;
+  static constexpr bool kReadsMasses = false;  // abi.h: DOMEL_CONTACT_IGNORES_MASSES
   static constexpr const char* kName = "restitution";
   static constexpr const char* kVersion = "1.0.0";
   static constexpr const char* kSummary =

@@ -24,6 +24,7 @@ using sdk::Vec3;
 class Dct {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_ROLLING;
+  static constexpr bool kReadsMasses = false;  // abi.h: DOMEL_CONTACT_IGNORES_MASSES
   static constexpr const char* kName = "dct";
   static constexpr const char* kVersion = "1.0.1";
   static constexpr const char* kSummary =

@@ -39,6 +39,7 @@ using sdk::Vec3;
 class SdCriticalAngle {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_ROLLING;
+  static constexpr bool kReadsMasses = false;  // abi.h: DOMEL_CONTACT_IGNORES_MASSES
   static constexpr const char* kName = "sd_critical_angle";
   static constexpr const char* kVersion = "1.0.0";
   static constexpr const char* kSummary =

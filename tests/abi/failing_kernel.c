@@ -3,10 +3,12 @@
  * A valid plugin written in plain C (no C++ layer) whose twisting kernel
  * always fails with DOMEL_ERR_RUNTIME and a message. It loads and creates
  * fine; the test proves the host turns the failure into a PluginError that
- * carries the plugin's message instead of crashing (case l).
+ * carries the plugin's message instead of crashing (case l). Its contact
+ * table has the ABI 2.0 size, to show how the host reads an older table.
  */
 #include <domel/sdk/abi.h>
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -39,7 +41,10 @@ static domel_status failing_contact(void* instance, domel_contact_batch_v2* batc
   return DOMEL_ERR_RUNTIME;
 }
 
-static const domel_contact_family_v2 kFamily = {sizeof(domel_contact_family_v2), 0u, failing_contact};
+/* The table as an ABI 2.0 plugin has it: it ends after `contact` (no
+ * `flags`), so the host zero-fills the rest and hands this stage the masses. */
+static const domel_contact_family_v2 kFamily = {
+    (uint32_t)(offsetof(domel_contact_family_v2, contact) + sizeof(domel_contact_fn)), 0u, failing_contact};
 static const domel_model_v2 kModel = {
     sizeof(domel_model_v2), DOMEL_KIND_TWISTING, "abi_failing_twisting", "1.0.0",
     "ABI test model: its kernel always fails", "{\"type\": \"object\"}",

@@ -133,6 +133,22 @@ TEST(AbiLoader, ValidPluginsLoadAndRun) {
   EXPECT_EQ(batch.tqx[0], 0.0);
 }
 
+// Guards ABI 2.1's masses on demand (abi.h, DOMEL_CONTACT_IGNORES_MASSES): a C++-layer model that
+// does not declare kReadsMasses = false, and a contact table of the 2.0 size (no flags), both get
+// the masses; the built-in models declare that they never read them.
+TEST(AbiLoader, MassesAreFilledUnlessEveryStageDeclaresItIgnoresThem) {
+  PluginRegistry registry;
+  registry.load(good("good_plugin"));
+  registry.load(good("failing_kernel"));
+  ModelInstance good_rolling(*registry.find(DOMEL_KIND_ROLLING, "abi_good_rolling"),
+                             {{"model", "abi_good_rolling"}, {"coefficient", 0.1}}, "test");
+  EXPECT_TRUE(good_rolling.reads_masses());
+  ModelInstance older_table(*registry.find(DOMEL_KIND_TWISTING, "abi_failing_twisting"),
+                            {{"model", "abi_failing_twisting"}}, "test");
+  EXPECT_TRUE(older_table.reads_masses());
+  EXPECT_EQ(registry.find(DOMEL_KIND_TWISTING, "abi_failing_twisting")->contact.flags, 0u);
+}
+
 // Guards the ABI-1 policy (docs/sdk-guide.md, "Versions"): a plugin built against SDK 1.1
 // (domel_plugin_entry_v1) is refused, naming its ABI 1.1, this runtime's ABI and the fix.
 TEST(AbiLoader, RefusesAbi1PluginNamingBothVersions) {

@@ -67,6 +67,7 @@ TEST(ContactPipeline, MixedPairBatchEqualsUniformBatchesBitForBit) {
   auto pipe = make_pipeline();
   const uint32_t stride = pipe->history_stride();
   ASSERT_EQ(stride, 6u);  // mindlin 3 + sd_critical_angle 3
+  EXPECT_FALSE(pipe->reads_masses());  // every built-in stage declares DOMEL_CONTACT_IGNORES_MASSES
   const domel_pair_v2 a = pair(5e8, 0.5, 0.3, 0.0), b = pair(2e9, 0.8, 0.7, 0.25);
   for (const auto& order : {std::vector<int>{0, 0, 0, 1, 1, 1}, std::vector<int>{0, 1, 0, 1, 1, 0}}) {
     const uint32_t n = static_cast<uint32_t>(order.size());

@@ -41,7 +41,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 2
-#define DOMEL_ABI_MINOR 0
+#define DOMEL_ABI_MINOR 1
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -185,11 +185,18 @@ typedef struct domel_contact_batch_v2 {
 typedef domel_status (*domel_contact_fn)(void* instance, domel_contact_batch_v2* batch, char* err,
                                          size_t err_capacity);
 
+/** domel_contact_family_v2::flags (ABI 2.1): the stage never reads the
+ *  batch's mass_i and mass_j, so the host may leave them unfilled (stale)
+ *  when no stage of the pipeline reads them: two stores per contact less. */
+#define DOMEL_CONTACT_IGNORES_MASSES 1u
+
 /** Callbacks of the contact family (kinds normal ... twisting). */
 typedef struct domel_contact_family_v2 {
   uint32_t struct_size;
   uint32_t history_slots;   /**< doubles of per-contact history this stage needs */
   domel_contact_fn contact; /**< required */
+  /* ABI 2.1 */
+  uint32_t flags;           /**< DOMEL_CONTACT_* bits; 0 (and a 2.0 table): every batch input is filled */
 } domel_contact_family_v2;
 
 /* ------------------------------------------------------------------------ */

@@ -136,6 +136,14 @@ template <class M>
 struct history_slots<M, std::void_t<decltype(M::kHistorySlots)>>
     : std::integral_constant<unsigned, M::kHistorySlots> {};
 
+/// A contact model declares `static constexpr bool kReadsMasses = false;`
+/// when it never reads the batch's mass_i/mass_j (abi.h,
+/// DOMEL_CONTACT_IGNORES_MASSES); without the declaration it gets them.
+template <class M, class = void>
+struct reads_masses : std::true_type {};
+template <class M>
+struct reads_masses<M, std::void_t<decltype(M::kReadsMasses)>> : std::bool_constant<M::kReadsMasses> {};
+
 constexpr bool is_contact_kind(domel_kind k) {
   return k == DOMEL_KIND_NORMAL || k == DOMEL_KIND_DAMPING || k == DOMEL_KIND_TANGENTIAL ||
          k == DOMEL_KIND_ROLLING || k == DOMEL_KIND_TWISTING;
@@ -289,7 +297,8 @@ struct Export {
   static const void* family() {
     if constexpr (is_contact_kind(M::kKind)) {
       static const domel_contact_family_v2 t = {sizeof(domel_contact_family_v2), history_slots<M>::value,
-                                                &Export::contact};
+                                                &Export::contact,
+                                                reads_masses<M>::value ? 0u : DOMEL_CONTACT_IGNORES_MASSES};
       return &t;
     } else if constexpr (M::kKind == DOMEL_KIND_INSERTION) {
       static const domel_insertion_family_v2 t = {sizeof(domel_insertion_family_v2), 0u, &Export::insert};
