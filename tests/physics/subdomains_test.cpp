@@ -6,6 +6,7 @@
 #include "support/fixture.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>  // getpid: the 1- and 2-thread variants of a test may run at once
 
 #include <filesystem>
 
@@ -40,7 +41,7 @@ json two_level(bool a, bool b) {
 
 void run(domel::platform::Simulation& sim, std::uint64_t macro_steps) {
   domel::platform::RunOptions opt;
-  opt.output_directory = std::filesystem::temp_directory_path() / "domel_subdomains_test";
+  opt.output_directory = std::filesystem::temp_directory_path() / ("domel_subdomains_test_" + std::to_string(::getpid()));
   opt.progress = false;
   opt.max_steps = macro_steps;
   sim.run(opt, dt::builtin_registry());
