@@ -72,7 +72,7 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
   for (double r : f.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r);
   for (double r : c.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r * scale);
   coarse_last_.clear();
-  for (std::size_t q = 0; q < c.size(); ++q) coarse_last_[c.id[q]] = {c.x[q], c.y[q], c.z[q]};
+  for (std::size_t q = 0; q < c.size(); ++q) coarse_last_[c.id[q]] = {c.x[q], c.y[q], c.z[q], c.mass[q]};
   if (out.empty()) return;
   std::vector<std::string> cols = {"time"};
   for (int face = 0; face < kFaces; ++face) {
@@ -84,6 +84,8 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
   }
   for (const char* k : {"outlet_removed_kg", "holdup_kg", "fine_particles", "fine_balance_residual_kg"})
     cols.emplace_back(k);
+  if (spec_.match_outflow)
+    for (const char* k : {"fine_lost_kg", "coarse_lost_kg", "coarse_sink_kg", "outflow_deficit_kg"}) cols.emplace_back(k);
   balance_ = std::make_unique<io::CsvSeries>(out / (spec_.name + "_balance.csv"), cols, 20);
   if (spec_.grid_interval > 0) {
     vtk_fine_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_fine");
@@ -104,6 +106,7 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
   auto t0 = clock::now();
   remove_escaped(fine, flow);
   count_inflow(coarse);
+  if (spec_.match_outflow) match_outflow(coarse, flow);
   auto t1 = clock::now();
   timing_.count += std::chrono::duration<double>(t1 - t0).count();
   // Due at the longest interval, or earlier once what a face counted since
@@ -154,10 +157,10 @@ void Coupling::count_inflow(const Subdomain& coarse) {
     lo[a] = g.lo[a] - margin;
     hi[a] = g.hi[a] + margin;
   }
-  std::unordered_map<std::uint64_t, std::array<double, 3>> now;
+  std::unordered_map<std::uint64_t, std::array<double, 4>> now;
   now.reserve(coarse_last_.size() + 64);
   for (std::size_t q = 0; q < s.size(); ++q) {
-    const std::array<double, 3> p = {s.x[q], s.y[q], s.z[q]};
+    const std::array<double, 4> p = {s.x[q], s.y[q], s.z[q], s.mass[q]};
     if (p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] || p[2] < lo[2] || p[2] > hi[2]) continue;
     now.emplace(s.id[q], p);
     const auto it = coarse_last_.find(s.id[q]);
@@ -198,7 +201,58 @@ void Coupling::count_inflow(const Subdomain& coarse) {
     for (double k = 0; k < whole; ++k) fb.queue.push_back(r_fine);
     fine_dmax_ = std::max(fine_dmax_, 2 * r_fine);
   }
+  if (spec_.match_outflow) {
+    // what the coarse parcels lost from the region by themselves: inside at
+    // the last count, and now outside it or gone (deleted by the coarse
+    // level's own outlet; a parcel cannot leave the followed margin within
+    // one interval, see above)
+    for (const auto& [id, prev] : coarse_last_) {
+      if (!inside_box(g, prev[0], prev[1], prev[2])) continue;
+      const auto it = now.find(id);
+      if (it == now.end() || !inside_box(g, it->second[0], it->second[1], it->second[2]))
+        outflow_.coarse += mass_units(prev[3]);
+    }
+  }
   coarse_last_.swap(now);
+}
+
+void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
+  const MassUnits fine_removed = flow.accounts().at(spec_.fine).removed;
+  const MassUnits fine_lost = fine_removed - fine_removed_seen_;
+  fine_removed_seen_ = fine_removed;
+  outflow_.fine += fine_lost;
+  // the deficit: the fine level's loss from the region minus the coarse
+  // level's, both since the start; negative while the coarse level leads
+  outflow_.deficit = mass_kg(outflow_.fine) - mass_kg(outflow_.coarse) - mass_kg(outflow_.sink);
+  ParticleStore& s = coarse.store();
+  double smallest = std::numeric_limits<double>::infinity();
+  const CellGridSpec& g = spec_.grid;
+  std::vector<std::pair<double, std::size_t>> inside;  // (height along -gravity, index)
+  const double* gr = coarse.body_forces().gravity;
+  const double gn = std::sqrt(gr[0] * gr[0] + gr[1] * gr[1] + gr[2] * gr[2]);
+  const double up[3] = {gn > 0 ? -gr[0] / gn : 0.0, gn > 0 ? -gr[1] / gn : 0.0, gn > 0 ? -gr[2] / gn : 1.0};
+  for (std::size_t q = 0; q < s.size(); ++q) {
+    if (!inside_box(g, s.x[q], s.y[q], s.z[q])) continue;
+    inside.emplace_back(up[0] * s.x[q] + up[1] * s.y[q] + up[2] * s.z[q], q);
+    smallest = std::min(smallest, s.mass[q]);
+  }
+  if (inside.empty() || outflow_.deficit < 0.5 * smallest) return;
+  std::sort(inside.begin(), inside.end());
+  std::vector<std::uint8_t> mark(s.size(), 0);
+  bool any = false;
+  // lowest first, each parcel removed while at least half its mass is owed:
+  // the deficit then stays within half a parcel of zero
+  for (const auto& [h, q] : inside) {
+    if (outflow_.deficit < 0.5 * s.mass[q]) break;
+    mark[q] = 1;
+    any = true;
+    outflow_.sink += mass_units(s.mass[q]);
+    ++outflow_.n_sink;
+    outflow_.deficit -= s.mass[q];
+    coarse_last_.erase(s.id[q]);  // booked here, not again as a parcel that vanished
+    flow.count_removed(spec_.coarse, s.id[q], s.mass[q]);
+  }
+  if (any) s.remove_marked(mark);
 }
 
 void Coupling::transfer(double t, Subdomain& fine, const std::vector<WallPrimitive>& walls, ParticleFlow& flow) {
@@ -448,6 +502,12 @@ void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& fl
   row.push_back(mass_kg(present));
   row.push_back(static_cast<double>(s.size()));
   row.push_back(mass_kg(flow.residual(spec_.fine, s)));
+  if (spec_.match_outflow) {
+    row.push_back(mass_kg(outflow_.fine));
+    row.push_back(mass_kg(outflow_.coarse));
+    row.push_back(mass_kg(outflow_.sink));
+    row.push_back(outflow_.deficit);
+  }
   balance_->append(row);
 }
 
@@ -508,6 +568,13 @@ nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& 
                            {"transfers", timing_.transfer},
                            {"controllers", timing_.control},
                            {"averaging", timing_.averaging}}},
+          {"match_outflow",
+           spec_.match_outflow ? nlohmann::json{{"fine_lost_kg", mass_kg(outflow_.fine)},
+                                                {"coarse_lost_kg", mass_kg(outflow_.coarse)},
+                                                {"coarse_sink_kg", mass_kg(outflow_.sink)},
+                                                {"coarse_sink_parcels", outflow_.n_sink},
+                                                {"deficit_kg", outflow_.deficit}}
+                               : nlohmann::json(false)},
           {"stress_control", spec_.stress.enabled ? spec_.stress.params : nlohmann::json(false)},
           {"velocity_control", spec_.velocity.enabled ? spec_.velocity.params : nlohmann::json(false)}};
 }

@@ -15,6 +15,9 @@
 //      (alpha_c/alpha_f)^3 per parcel, placed in the shell behind the face by
 //      sequential simple inhibition with the face's mass-weighted velocity;
 //      what cannot be placed waits (the backlog);
+//   3a. with match_outflow, removes the coarse parcels lowest in the region
+//      while the fine level has lost more mass from the region than the
+//      coarse level (the coarse outflow then follows the fine discharge);
 //   4. hands both levels' cell averages (sampled at the step that ended at
 //      this time) and particles to its two controller plugins, the fine
 //      boundary PI stress controller and the coarse P velocity controller,
@@ -76,6 +79,7 @@ struct CouplingSpec {
   double fill_target = 0.1;
   int attempts = 1000;
   double grid_interval = 0;          ///< [s] between grid files; 0: none
+  bool match_outflow = false;        ///< remove coarse parcels so the coarse outflow follows the fine one
   std::uint64_t seed = 1;
   // timing, resolved from the levels' sub-steps per macro step
   std::uint64_t control_macro = 1;   ///< macro steps per control interval
@@ -120,6 +124,16 @@ class Coupling {
   CellGrid& fine_grid() { return *fine_grid_; }
   CellGrid& coarse_grid() { return *coarse_grid_; }
   const std::array<FaceBalance, kFaces>& faces() const { return faces_; }
+  /// The outflow books of the region in exact mass units: what the fine
+  /// level lost from it (faces and deletion regions), what the coarse
+  /// parcels lost by themselves (left the box or were deleted), what
+  /// match_outflow removed, and the deficit still owed [kg].
+  struct Outflow {
+    MassUnits fine = 0, coarse = 0, sink = 0;
+    std::uint64_t n_sink = 0;
+    double deficit = 0;
+  };
+  const Outflow& outflow() const { return outflow_; }
 
   /// Before the first step: accessible volumes, the coarse parcels' sides,
   /// the balance file. `out` empty: no files.
@@ -151,6 +165,7 @@ class Coupling {
  private:
   void remove_escaped(Subdomain& fine, ParticleFlow& flow);
   void count_inflow(const Subdomain& coarse);
+  void match_outflow(Subdomain& coarse, ParticleFlow& flow);
   void transfer(double t, Subdomain& fine, const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
   std::size_t insert_face(int face, double t, Subdomain& fine, const std::vector<WallPrimitive>& walls,
                           std::uint64_t& next_id);
@@ -161,7 +176,8 @@ class Coupling {
   CouplingSpec spec_;
   std::unique_ptr<CellGrid> fine_grid_, coarse_grid_;
   std::array<FaceBalance, kFaces> faces_;
-  std::unordered_map<std::uint64_t, std::array<double, 3>> coarse_last_;  ///< parcel id -> position at the last count
+  /// parcel id -> position and mass at the last count, for the parcels near the region
+  std::unordered_map<std::uint64_t, std::array<double, 4>> coarse_last_;
   std::unordered_set<std::uint64_t> counted_ids_;                         ///< parcels already counted (count once)
   std::mt19937_64 rng_;
   std::uint64_t controls_ = 0, transfers_ = 0;
@@ -169,6 +185,8 @@ class Coupling {
   double last_t_ = 0;
   double last_row_t_ = -1;
   Timing timing_;
+  Outflow outflow_;
+  MassUnits fine_removed_seen_ = 0;   ///< the fine level's removed mass at the last interval
   double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
   std::unique_ptr<io::CsvSeries> balance_;
   std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;

@@ -626,6 +626,7 @@ void build_couplings(Build& b) {
     s.fill_target = cj["fill_target"].get<double>();
     s.attempts = cj["insertion_attempts"].get<int>();
     s.grid_interval = cj["grid_interval"].get<double>();
+    s.match_outflow = cj["match_outflow"].get<bool>();
     s.fine_density = sim.materials[fine.material()].density;
     s.alpha_ratio = fine.coarse_grain() / coarse.coarse_grain();
     // one seed per coupling: the run's seed and the coupling's index mixed as the pours' seeds are

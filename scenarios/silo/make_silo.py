@@ -18,7 +18,8 @@ and the coupled ones (docs/multilevel.md, docs/validation/multilevel.md):
                     in the lower quarter;
   silo_ci_2lvl.json silo_ci at alpha = 2 with a fine level in its lower half
                     (the CI-sized coupled case), and silo_ci_2lvl_nostress.json
-                    the same without the stress controller.
+                    the same without the stress controller, and
+                    silo_ci_2lvl_nomatch.json without match_outflow.
 Every variant has a grid "zone" with the fine region's cells, so that the
 pressure in the transition cells compares level by level.
 Each pours at a mass rate from a cylinder near the top (random sequential
@@ -127,9 +128,11 @@ def zone_grid(name, R, z):
     return dict(name=name, **zone_box(R, z), every=15, write_interval=0.05)
 
 
-def multilevel(name, base, levels, stress=True):
+def multilevel(name, base, levels, stress=True, match=True):
     """The base silo at the coarsest level's alpha, plus one finer subdomain
-    per further level, each coupled to the one before it on its zone."""
+    per further level, each coupled to the one before it on its zone. Every
+    zone holds the outlet, so each coupling matches the coarse outflow to the
+    fine one (match_outflow, docs/multilevel.md) unless match is False."""
     v = dict(VARIANTS[base])
     v["alpha"] = levels[0][0]
     doc = scenario(name, **v)
@@ -146,7 +149,8 @@ def multilevel(name, base, levels, stress=True):
             "name": f"alpha{alpha}", "material": "glass", "coarse_grain": alpha,
             "contact": coarse["contact"], "time_step": 1.8e-5 * alpha, "impact_velocity": 1.0})
         c = {"name": f"zone{k}", "coarse": f"alpha{levels[k - 1][0]}", "fine": f"alpha{alpha}",
-             "region": zone_box(R, ZONES[zone]), "inflow_faces": ["+z"], "grid_interval": 0.05}
+             "region": zone_box(R, ZONES[zone]), "inflow_faces": ["+z"], "match_outflow": match,
+             "grid_interval": 0.05}
         if not stress:
             c["stress_control"] = {"enabled": False}
         doc["couplings"].append(c)
@@ -164,9 +168,11 @@ if __name__ == "__main__":
             f.write("\n")
         print("wrote", name + ".json")
     for name, (base, levels) in MULTILEVEL.items():
-        variants = [(name, True)] + ([(name + "_nostress", False)] if name == "silo_ci_2lvl" else [])
-        for out, stress in variants:
+        variants = [(name, True, True)]
+        if name == "silo_ci_2lvl":
+            variants += [(name + "_nostress", False, True), (name + "_nomatch", True, False)]
+        for out, stress, match in variants:
             with open(os.path.join(HERE, out + ".json"), "w") as f:
-                json.dump(multilevel(out, base, levels, stress), f, indent=2)
+                json.dump(multilevel(out, base, levels, stress, match), f, indent=2)
                 f.write("\n")
             print("wrote", out + ".json")

@@ -14,6 +14,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <string>
+
+#include <unistd.h>  // getpid: the 1- and 2-thread variants of a test may run at once
 
 namespace dt = domel::test;
 namespace dp = domel::platform;
@@ -189,6 +192,56 @@ TEST(Coupling, WhatCannotBePlacedWaitsAsBacklog) {
   EXPECT_EQ(top.n_inserted, 0u);
 }
 
+TEST(Coupling, MatchOutflowRemovesTheLowestCoarseParcelsWhileTheFineLevelLostMore) {
+  json doc = two_level(-9.81);
+  doc["couplings"][0]["match_outflow"] = true;
+  Levels s = make(doc);
+  auto& c = s.coarse();
+  for (std::size_t q : above(c, 2)) c.z[q] = 0.02;
+  s.exchange(1e-3);
+  auto& f = s.fine();
+  ASSERT_EQ(f.size(), 16u);
+  const double mf = f.mass[0], mc = 8 * mf;  // alpha 2 over alpha 1: a parcel is 8 fine particles
+  // the lowest parcel in the region, and one below the region (outside it: never a candidate)
+  std::size_t lowest = 0, below = 1;
+  for (std::size_t q = 0; q < c.size(); ++q)
+    if (c.z[q] < 0.01) { lowest = q; break; }
+  for (std::size_t q = lowest + 1; q < c.size(); ++q)
+    if (c.z[q] < 0.01) { below = q; break; }
+  c.z[lowest] = 0.0005;
+  c.z[below] = -0.004;  // left the region by itself: the coarse level lost one parcel
+  const std::uint64_t lowest_id = c.id[lowest];
+  s.exchange(2e-3);
+  const auto& out = s.c->outflow();
+  EXPECT_EQ(out.coarse, dp::mass_units(mc));
+  EXPECT_EQ(out.n_sink, 0u);
+  EXPECT_NEAR(out.deficit, -mc, 1e-12 * mc);
+  // the fine level loses 11 particles through -z: 11/8 parcels, 3/8 beyond the coarse loss, under half a parcel
+  for (std::size_t q = 0; q < 11; ++q) f.z[q] = -0.0005;
+  s.exchange(3e-3);
+  EXPECT_EQ(out.fine, 11 * dp::mass_units(mf));
+  EXPECT_EQ(out.n_sink, 0u);
+  EXPECT_NEAR(out.deficit, 3 * mf, 1e-9 * mf);
+  // two more: 5/8 of a parcel owed, so the lowest parcel in the region goes and 3/8 is owed back
+  const std::size_t n_coarse = c.size();
+  f.z[0] = -0.0005;
+  f.z[1] = -0.0005;
+  s.exchange(4e-3);
+  EXPECT_EQ(out.n_sink, 1u);
+  EXPECT_EQ(out.sink, dp::mass_units(mc));
+  EXPECT_NEAR(out.deficit, -3 * mf, 1e-9 * mf);
+  ASSERT_EQ(c.size(), n_coarse - 1);
+  for (std::size_t q = 0; q < c.size(); ++q) EXPECT_NE(c.id[q], lowest_id) << "the lowest parcel is still there";
+  // the removed parcel is booked once, as the sink's: no second loss when it is missed at the next count
+  s.exchange(5e-3);
+  EXPECT_EQ(out.coarse, dp::mass_units(mc));
+  EXPECT_EQ(out.sink, dp::mass_units(mc));
+  // the books of both levels close exactly
+  EXPECT_EQ(out.fine, 13 * dp::mass_units(mf));
+  EXPECT_EQ(s.sim->flow.residual(0, c), 0);
+  EXPECT_EQ(s.sim->flow.residual(1, f), 0);
+}
+
 TEST(Coupling, ExchangesHappenWhenAllLevelsStandAtTheSameTime) {
   json doc = two_level(-9.81);
   doc["couplings"][0]["control_steps"] = 15;  // 16 fine steps = 8 macro steps of 3.6e-5 s
@@ -211,7 +264,7 @@ TEST(Coupling, ExchangesHappenWhenAllLevelsStandAtTheSameTime) {
     seen.push_back({m.t, sds[1]->time(), sds[0]->time(), static_cast<double>(sds[1]->steps())});
   });
   dp::RunOptions opt;
-  opt.output_directory = std::filesystem::temp_directory_path() / "domel_coupling_test";
+  opt.output_directory = std::filesystem::temp_directory_path() / ("domel_coupling_test_" + std::to_string(::getpid()));
   opt.progress = false;
   opt.max_steps = 41;
   sim->run(opt, dt::builtin_registry());
@@ -252,7 +305,7 @@ TEST(Coupling, NestsThreeLevels) {
   auto sim = dt::build(doc);
   EXPECT_EQ(sim->control_macro, 4u);  // 15 fine steps asked, 4 per macro step of 7.2e-5 s
   dp::RunOptions opt;
-  opt.output_directory = std::filesystem::temp_directory_path() / "domel_coupling_nest_test";
+  opt.output_directory = std::filesystem::temp_directory_path() / ("domel_coupling_nest_test_" + std::to_string(::getpid()));
   opt.progress = false;
   opt.max_steps = 240;  // 17 ms: the block reaches the lower region
   sim->run(opt, dt::builtin_registry());
