@@ -28,6 +28,18 @@ bool inside_box(const CellGridSpec& g, double x, double y, double z) {
   return x >= g.lo[0] && x <= g.hi[0] && y >= g.lo[1] && y <= g.hi[1] && z >= g.lo[2] && z <= g.hi[2];
 }
 
+/// The face of the box beyond which a point lies farthest, -1 inside.
+int face_beyond(const CellGridSpec& g, double x, double y, double z) {
+  const double p[3] = {x, y, z};
+  int face = -1;
+  double beyond = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (g.lo[a] - p[a] > beyond) beyond = g.lo[a] - p[a], face = 2 * a;
+    if (p[a] - g.hi[a] > beyond) beyond = p[a] - g.hi[a], face = 2 * a + 1;
+  }
+  return face;
+}
+
 /// Consecutive transfers with a growing backlog before the warning.
 constexpr int kBacklogWarnAfter = 5;
 
@@ -127,13 +139,7 @@ void Coupling::remove_escaped(Subdomain& fine, ParticleFlow& flow) {
   std::vector<std::uint8_t> mark(s.size(), 0);
   bool any = false;
   for (std::size_t q = 0; q < s.size(); ++q) {
-    const double p[3] = {s.x[q], s.y[q], s.z[q]};
-    int face = -1;
-    double beyond = 0;
-    for (int a = 0; a < 3; ++a) {
-      if (g.lo[a] - p[a] > beyond) beyond = g.lo[a] - p[a], face = 2 * a;
-      if (p[a] - g.hi[a] > beyond) beyond = p[a] - g.hi[a], face = 2 * a + 1;
-    }
+    const int face = face_beyond(g, s.x[q], s.y[q], s.z[q]);
     if (face < 0) continue;
     mark[q] = 1;
     any = true;
@@ -202,27 +208,34 @@ void Coupling::count_inflow(const Subdomain& coarse) {
     fine_dmax_ = std::max(fine_dmax_, 2 * r_fine);
   }
   if (spec_.match_outflow) {
-    // what the coarse parcels lost from the region by themselves: inside at
-    // the last count, and now outside it or gone (deleted by the coarse
-    // level's own outlet; a parcel cannot leave the followed margin within
-    // one interval, see above)
+    // What the coarse parcels discharged by themselves: inside at the last
+    // count, and now gone (deleted by the coarse level's own outlet; a parcel
+    // cannot leave the followed margin within one interval, see above) or
+    // outside through a face that is not an inflow face. A parcel that goes
+    // out through an inflow face (a bounce during a fill) is the transfer's
+    // business: it comes back, and is counted once.
     for (const auto& [id, prev] : coarse_last_) {
       if (!inside_box(g, prev[0], prev[1], prev[2])) continue;
       const auto it = now.find(id);
-      if (it == now.end() || !inside_box(g, it->second[0], it->second[1], it->second[2]))
-        outflow_.coarse += mass_units(prev[3]);
+      if (it != now.end()) {
+        const int face = face_beyond(g, it->second[0], it->second[1], it->second[2]);
+        if (face < 0 || spec_.inflow[face]) continue;
+      }
+      outflow_.coarse += mass_units(prev[3]);
     }
   }
   coarse_last_.swap(now);
 }
 
 void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
-  const MassUnits fine_removed = flow.accounts().at(spec_.fine).removed;
-  const MassUnits fine_lost = fine_removed - fine_removed_seen_;
-  fine_removed_seen_ = fine_removed;
-  outflow_.fine += fine_lost;
-  // the deficit: the fine level's loss from the region minus the coarse
-  // level's, both since the start; negative while the coarse level leads
+  // the fine discharge: everything the fine level lost (its faces and its
+  // deletion regions) but what left through an inflow face
+  MassUnits fine_out = flow.accounts().at(spec_.fine).removed;
+  for (int face = 0; face < kFaces; ++face)
+    if (spec_.inflow[face]) fine_out -= faces_[face].removed;
+  outflow_.fine = fine_out;
+  // the deficit: the fine discharge minus the coarse one, both since the
+  // start; negative while the coarse level leads
   outflow_.deficit = mass_kg(outflow_.fine) - mass_kg(outflow_.coarse) - mass_kg(outflow_.sink);
   ParticleStore& s = coarse.store();
   double smallest = std::numeric_limits<double>::infinity();

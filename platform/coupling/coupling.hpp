@@ -16,8 +16,9 @@
 //      sequential simple inhibition with the face's mass-weighted velocity;
 //      what cannot be placed waits (the backlog);
 //   3a. with match_outflow, removes the coarse parcels lowest in the region
-//      while the fine level has lost more mass from the region than the
-//      coarse level (the coarse outflow then follows the fine discharge);
+//      while the fine level has discharged more mass from the region than
+//      the coarse level (through faces that are not inflow faces, or by
+//      deletion): the coarse outflow then follows the fine discharge;
 //   4. hands both levels' cell averages (sampled at the step that ended at
 //      this time) and particles to its two controller plugins, the fine
 //      boundary PI stress controller and the coarse P velocity controller,
@@ -124,9 +125,10 @@ class Coupling {
   CellGrid& fine_grid() { return *fine_grid_; }
   CellGrid& coarse_grid() { return *coarse_grid_; }
   const std::array<FaceBalance, kFaces>& faces() const { return faces_; }
-  /// The outflow books of the region in exact mass units: what the fine
-  /// level lost from it (faces and deletion regions), what the coarse
-  /// parcels lost by themselves (left the box or were deleted), what
+  /// The outflow books of the region in exact mass units, for
+  /// match_outflow: the fine discharge (removed at faces that are not
+  /// inflow faces and by deletion regions), the coarse discharge by itself
+  /// (parcels that left the box through such a face or were deleted), what
   /// match_outflow removed, and the deficit still owed [kg].
   struct Outflow {
     MassUnits fine = 0, coarse = 0, sink = 0;
@@ -186,7 +188,6 @@ class Coupling {
   double last_row_t_ = -1;
   Timing timing_;
   Outflow outflow_;
-  MassUnits fine_removed_seen_ = 0;   ///< the fine level's removed mass at the last interval
   double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
   std::unique_ptr<io::CsvSeries> balance_;
   std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;

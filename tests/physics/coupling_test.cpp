@@ -192,7 +192,7 @@ TEST(Coupling, WhatCannotBePlacedWaitsAsBacklog) {
   EXPECT_EQ(top.n_inserted, 0u);
 }
 
-TEST(Coupling, MatchOutflowRemovesTheLowestCoarseParcelsWhileTheFineLevelLostMore) {
+TEST(Coupling, MatchOutflowRemovesTheLowestCoarseParcelsWhileTheFineLevelDischargedMore) {
   json doc = two_level(-9.81);
   doc["couplings"][0]["match_outflow"] = true;
   Levels s = make(doc);
@@ -209,16 +209,24 @@ TEST(Coupling, MatchOutflowRemovesTheLowestCoarseParcelsWhileTheFineLevelLostMor
   for (std::size_t q = lowest + 1; q < c.size(); ++q)
     if (c.z[q] < 0.01) { below = q; break; }
   c.z[lowest] = 0.0005;
-  c.z[below] = -0.004;  // left the region by itself: the coarse level lost one parcel
+  c.z[below] = -0.004;  // left the region by itself through -z: the coarse level discharged one parcel
+  // one bounces out through the inflow face +z: the transfer's business (it comes back), not a discharge
+  std::size_t bounced = 0;
+  for (std::size_t q = 0; q < c.size(); ++q)
+    if (q != lowest && q != below && c.z[q] > 0.015 && c.z[q] < 0.03) { bounced = q; break; }
+  c.z[bounced] = 0.035;
   const std::uint64_t lowest_id = c.id[lowest];
   s.exchange(2e-3);
   const auto& out = s.c->outflow();
   EXPECT_EQ(out.coarse, dp::mass_units(mc));
   EXPECT_EQ(out.n_sink, 0u);
   EXPECT_NEAR(out.deficit, -mc, 1e-12 * mc);
-  // the fine level loses 11 particles through -z: 11/8 parcels, 3/8 beyond the coarse loss, under half a parcel
+  // the fine level discharges 11 particles through -z: 11/8 parcels, 3/8 beyond the coarse discharge, under
+  // half a parcel; one more leaves through the inflow face +z and is not a discharge
   for (std::size_t q = 0; q < 11; ++q) f.z[q] = -0.0005;
+  f.z[11] = 0.0305;
   s.exchange(3e-3);
+  EXPECT_EQ(s.c->faces()[5].n_removed, 1u);
   EXPECT_EQ(out.fine, 11 * dp::mass_units(mf));
   EXPECT_EQ(out.n_sink, 0u);
   EXPECT_NEAR(out.deficit, 3 * mf, 1e-9 * mf);
@@ -238,6 +246,7 @@ TEST(Coupling, MatchOutflowRemovesTheLowestCoarseParcelsWhileTheFineLevelLostMor
   EXPECT_EQ(out.sink, dp::mass_units(mc));
   // the books of both levels close exactly
   EXPECT_EQ(out.fine, 13 * dp::mass_units(mf));
+  EXPECT_EQ(out.coarse, dp::mass_units(mc));
   EXPECT_EQ(s.sim->flow.residual(0, c), 0);
   EXPECT_EQ(s.sim->flow.residual(1, f), 0);
 }
