@@ -237,6 +237,7 @@ void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
   // the deficit: the fine discharge minus the coarse one, both since the
   // start; negative while the coarse level leads
   outflow_.deficit = mass_kg(outflow_.fine) - mass_kg(outflow_.coarse) - mass_kg(outflow_.sink);
+  if (outflow_.deficit <= 0) return;  // nothing owed: no scan (the coarse level leads or is level)
   ParticleStore& s = coarse.store();
   double smallest = std::numeric_limits<double>::infinity();
   const CellGridSpec& g = spec_.grid;
