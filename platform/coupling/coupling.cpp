@@ -234,10 +234,8 @@ void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
   for (int face = 0; face < kFaces; ++face)
     if (spec_.inflow[face]) fine_out -= faces_[face].removed;
   outflow_.fine = fine_out;
-  // the deficit: the fine discharge minus the coarse one, both since the
-  // start; negative while the coarse level leads
-  outflow_.deficit = mass_kg(outflow_.fine) - mass_kg(outflow_.coarse) - mass_kg(outflow_.sink);
-  if (outflow_.deficit <= 0) return;  // nothing owed: no scan (the coarse level leads or is level)
+  double owed = outflow_.deficit();
+  if (owed <= 0) return;  // nothing owed: no scan (the coarse level leads or is level)
   ParticleStore& s = coarse.store();
   double smallest = std::numeric_limits<double>::infinity();
   const CellGridSpec& g = spec_.grid;
@@ -250,19 +248,19 @@ void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
     inside.emplace_back(up[0] * s.x[q] + up[1] * s.y[q] + up[2] * s.z[q], q);
     smallest = std::min(smallest, s.mass[q]);
   }
-  if (inside.empty() || outflow_.deficit < 0.5 * smallest) return;
+  if (inside.empty() || owed < 0.5 * smallest) return;
   std::sort(inside.begin(), inside.end());
   std::vector<std::uint8_t> mark(s.size(), 0);
   bool any = false;
   // lowest first, each parcel removed while at least half its mass is owed:
   // the deficit then stays within half a parcel of zero
   for (const auto& [h, q] : inside) {
-    if (outflow_.deficit < 0.5 * s.mass[q]) break;
+    if (owed < 0.5 * s.mass[q]) break;
     mark[q] = 1;
     any = true;
     outflow_.sink += mass_units(s.mass[q]);
     ++outflow_.n_sink;
-    outflow_.deficit -= s.mass[q];
+    owed -= s.mass[q];
     coarse_last_.erase(s.id[q]);  // booked here, not again as a parcel that vanished
     flow.count_removed(spec_.coarse, s.id[q], s.mass[q]);
   }
@@ -520,7 +518,7 @@ void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& fl
     row.push_back(mass_kg(outflow_.fine));
     row.push_back(mass_kg(outflow_.coarse));
     row.push_back(mass_kg(outflow_.sink));
-    row.push_back(outflow_.deficit);
+    row.push_back(outflow_.deficit());
   }
   balance_->append(row);
 }
@@ -587,7 +585,7 @@ nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& 
                                                 {"coarse_lost_kg", mass_kg(outflow_.coarse)},
                                                 {"coarse_sink_kg", mass_kg(outflow_.sink)},
                                                 {"coarse_sink_parcels", outflow_.n_sink},
-                                                {"deficit_kg", outflow_.deficit}}
+                                                {"deficit_kg", outflow_.deficit()}}
                                : nlohmann::json(false)},
           {"stress_control", spec_.stress.enabled ? spec_.stress.params : nlohmann::json(false)},
           {"velocity_control", spec_.velocity.enabled ? spec_.velocity.params : nlohmann::json(false)}};

@@ -133,7 +133,9 @@ class Coupling {
   struct Outflow {
     MassUnits fine = 0, coarse = 0, sink = 0;
     std::uint64_t n_sink = 0;
-    double deficit = 0;
+    /// [kg] the fine discharge minus the coarse one and the sink's, since the
+    /// start; negative while the coarse level leads
+    double deficit() const { return mass_kg(fine) - mass_kg(coarse) - mass_kg(sink); }
   };
   const Outflow& outflow() const { return outflow_; }
 
