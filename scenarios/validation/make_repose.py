@@ -7,24 +7,63 @@ removed and the heap settles until t = 1.25 s. Rolling resistance: dct with
 mu_r = 0.1 (LIGGGHTS cdt), sd_critical_angle with theta_c = atan(0.1)
 (compared with LIGGGHTS epsd2), or none. Lattices are anchored at the origin
 as LIGGGHTS' 'lattice sc ... origin 0.5 0.5 0.5' is, so the counts match
-(4624 floor + 5760 mobile). Usage: make_repose.py [seed]"""
-import json, math, sys
+(4624 floor + 5760 mobile). With --epsd-library PATH it also writes
+repose_epsd2.json: the out-of-tree example plugin (examples/third_party_rolling,
+built as libdomel_rolling_epsd.so), loaded from PATH, as LIGGGHTS epsd2 with
+mu_r = 0.1 (Iwashita-Oda stiffness, no dashpot): the same model in both codes.
+With --theta-c DEG [DEG ...] it also writes repose_sd_tc<DEG>.json:
+sd_critical_angle at those critical angles (0 means no rolling resistance),
+for the theta_c -> angle-of-repose curve of docs/rolling.md.
+Usage: make_repose.py [seed] [--epsd-library PATH] [--theta-c DEG [DEG ...]]"""
+import json, math, os, sys
 
+args = sys.argv[1:]
+library = None
+if "--epsd-library" in args:
+    k = args.index("--epsd-library")
+    if k + 1 >= len(args):
+        sys.exit("make_repose.py: --epsd-library needs the path of libdomel_rolling_epsd.so")
+    library = os.path.abspath(args[k + 1])
+    if not os.path.isfile(library):
+        sys.exit(f"make_repose.py: --epsd-library: no file {library}")
+    del args[k:k + 2]
+angles = []
+if "--theta-c" in args:
+    k = args.index("--theta-c")
+    rest = args[k + 1:]
+    n = 0
+    while n < len(rest) and rest[n].replace(".", "", 1).isdigit():
+        n += 1
+    if n == 0:
+        sys.exit("make_repose.py: --theta-c needs one or more angles in degrees")
+    angles = [float(x) for x in rest[:n]]
+    if any(not 0.0 <= x < 90.0 for x in angles):
+        sys.exit("make_repose.py: --theta-c angles must lie in [0, 90) degrees")
+    del args[k:k + 1 + n]
+
+# the scenarios' description: the deck, without the generator's options
+DECK = " ".join(__doc__.split("Rolling resistance:")[0].split()).replace("Writes repose_{sd,dct,none}.json: ", "", 1)
 d = 0.0028
 a = 1.02 * d
 Rc = 0.033
-seed = int(sys.argv[1]) if len(sys.argv) > 1 else 15485863
-suffix = "" if len(sys.argv) <= 1 else f"_s{seed}"
+seed = int(args[0]) if args else 15485863
+suffix = f"_s{seed}" if args else ""
 models = {
     "sd": {"model": "sd_critical_angle", "critical_angle": math.degrees(math.atan(0.1))},
     "dct": {"model": "dct", "rolling_friction": 0.1},
     "none": {"model": "none"},
 }
+for deg in angles:
+    models[f"sd_tc{deg:g}"] = ({"model": "none"} if deg == 0.0 else
+                               {"model": "sd_critical_angle", "critical_angle": deg})
+if library:
+    models["epsd2"] = {"model": "epsd", "rolling_friction": 0.1, "stiffness": "iwashita_oda", "dashpot": False}
 for tag, rolling in models.items():
     doc = {
         "$schema": "../../docs/domel.schema.json",
         "name": f"repose_{tag}{suffix}",
-        "description": __doc__.split("Usage")[0].strip().replace("\n", " "),
+        "description": DECK + " Rolling resistance: " + json.dumps(rolling) + ".",
+        **({"plugins": [library]} if tag == "epsd2" else {}),
         "gravity": [0, 0, -9.81],
         "materials": {"beads": {"density": 2500, "youngs_modulus": 5e6, "poisson_ratio": 0.3}},
         "interactions": [{"materials": ["beads", "beads"], "restitution": 0.5, "friction": 0.5}],

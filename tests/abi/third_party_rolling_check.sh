@@ -9,9 +9,12 @@
 #    scenario names it by a path relative to itself), runs it with the
 #    installed domel, and checks summary.json: rolling model "epsd" from the
 #    library "third_party_rolling", and a settled pile (final kinetic energy
-#    below 1 % of the run's peak in probes.csv);
+#    below 1 % of the run's peak in probes.csv); the same for a copy with the
+#    options that make it LIGGGHTS epsd2 (Iwashita-Oda stiffness, no dashpot);
 # 4. `domel validate` on a copy with a misspelt epsd parameter: exit code 2
-#    and a did-you-mean naming the right key;
+#    and a did-you-mean naming the right key; the same for a misspelt
+#    stiffness value, and `domel run` on viscous damping without a dashpot:
+#    a non-zero exit code and the plugin's message;
 # 5. removes the temporary folder, whatever happened.
 # The example's source folder is only read: nothing is written into it.
 set -euo pipefail
@@ -59,19 +62,28 @@ nice cmake --build "$tmp/build" -j1 >"$tmp/build.log" 2>&1 || {
 [[ -f "$tmp/build/$module_name" ]] || fail "no $module_name in $tmp/build"
 echo "built $tmp/build/$module_name"
 
-echo "== 3. run scenario.json with the plugin loaded by path"
+echo "== 3. run scenario.json with the plugin loaded by path, as LIGGGHTS epsd and as epsd2"
 cp "$project/scenario.json" "$tmp/build/scenario.json"
-"$domel" run "$tmp/build/scenario.json" --out "$tmp/out" --quiet >"$tmp/run.log" 2>&1 || {
+python3 - "$tmp/build/scenario.json" "$tmp/build/scenario_epsd2.json" <<'EOF' || fail "could not write scenario_epsd2.json"
+import json, sys
+doc = json.load(open(sys.argv[1]))
+for sd in doc["subdomains"]:
+    sd["contact"]["rolling"] = {"model": "epsd", "rolling_friction": 0.2, "stiffness": "iwashita_oda", "dashpot": False}
+json.dump(doc, open(sys.argv[2], "w"), indent=2)
+EOF
+for variant in scenario scenario_epsd2; do
+echo "-- $variant.json"
+"$domel" run "$tmp/build/$variant.json" --out "$tmp/out_$variant" --quiet >"$tmp/run.log" 2>&1 || {
   rc=$?
   cat "$tmp/run.log" >&2
-  fail "domel run exited with $rc"
+  fail "domel run $variant.json exited with $rc"
 }
 cat "$tmp/run.log"
 if grep "refused" "$tmp/run.log" | grep -q "$module_name"; then
   fail "domel refused $module_name"
 fi
-[[ -f "$tmp/out/summary.json" ]] || fail "no summary.json in $tmp/out"
-python3 - "$tmp/out" "$tmp/build/$module_name" <<'EOF' || fail "summary.json check failed"
+[[ -f "$tmp/out_$variant/summary.json" ]] || fail "no summary.json in $tmp/out_$variant"
+python3 - "$tmp/out_$variant" "$tmp/build/$module_name" <<'EOF' || fail "summary.json check failed"
 import csv, json, os, sys
 out, module = sys.argv[1], sys.argv[2]
 s = json.load(open(os.path.join(out, "summary.json")))
@@ -104,6 +116,7 @@ for e in errors:
     print("error: " + e, file=sys.stderr)
 sys.exit(1 if errors else 0)
 EOF
+done
 
 echo "== 4. domel validate reports a misspelt epsd parameter"
 sed 's/"rolling_friction"/"rolling_fricton"/' "$tmp/build/scenario.json" >"$tmp/build/scenario_typo.json"
@@ -116,6 +129,22 @@ grep -Fq "unknown property 'rolling_fricton' (did you mean 'rolling_friction'?)"
   fail "no did-you-mean for 'rolling_fricton'"
 grep -Fq "missing required property 'rolling_friction'" "$tmp/validate.log" ||
   fail "the missing required 'rolling_friction' is not reported"
+
+echo "== 4b. a misspelt stiffness, and viscous damping without a dashpot"
+sed 's/"iwashita_oda"/"iwashita"/' "$tmp/build/scenario_epsd2.json" >"$tmp/build/scenario_enum.json"
+rc=0
+"$domel" validate "$tmp/build/scenario_enum.json" >"$tmp/validate.log" 2>&1 || rc=$?
+cat "$tmp/validate.log"
+[[ $rc -eq 2 ]] || fail "domel validate exited with $rc on stiffness 'iwashita', expected 2"
+grep -Fq "iwashita_oda" "$tmp/validate.log" || fail "the error for stiffness 'iwashita' does not name 'iwashita_oda'"
+sed 's/"dashpot": false/"dashpot": false, "viscous_damping": 0.3/' "$tmp/build/scenario_epsd2.json" \
+  >"$tmp/build/scenario_contradiction.json"
+grep -q '"viscous_damping": 0.3' "$tmp/build/scenario_contradiction.json" || fail "could not make the contradiction copy"
+rc=0
+"$domel" run "$tmp/build/scenario_contradiction.json" --out "$tmp/out_contradiction" --quiet >"$tmp/run.log" 2>&1 || rc=$?
+cat "$tmp/run.log"
+[[ $rc -ne 0 ]] || fail "domel run accepted viscous_damping 0.3 with dashpot false"
+grep -Fq "'dashpot' is false" "$tmp/run.log" || fail "the plugin's message about the dashpot is not shown"
 
 echo "== 5. clean up $tmp"
 echo "third_party_rolling_check: OK"

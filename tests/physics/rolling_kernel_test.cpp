@@ -15,12 +15,21 @@
 //  - dct (§2.1, §3.8): |M| = mu_r R* F_n,el exactly, opposite omega_r, zero
 //    for omega_r = 0, twisting part ignored, mu_r = tan(theta_c) from
 //    "critical_angle".
+//  - the out-of-tree example `epsd` (examples/third_party_rolling/epsd.cpp,
+//    compiled into this test from its source; §2.2-2.3): k_r = 2.25 k_n
+//    mu_r^2 R*^2 ("stiffness": "ai", LIGGGHTS epsd) or k_t R*^2 with
+//    k_t = 8 G* sqrt(R* delta) ("iwashita_oda", LIGGGHTS epsd2), the dashpot
+//    C_r = eta_r 2 sqrt(I_r k_r) below the cap or none ("dashpot": false),
+//    |M| = mu_r R* F_n once capped.
 // Tolerances: the cap is a single rescale m *= M_ref/|m|, so it holds to a
 // few ulps: relative 1e-12 (§9 row 3). The elastic law accumulates theta_r as
 // a sum of omega_r dt over up to a few thousand steps; its round-off is
 // ~ steps * 1e-16, so relative 1e-11 is used there.
 #include "plugins/rolling/dct.hpp"
 #include "plugins/rolling/sd_critical_angle.hpp"
+// The example is one source file with its class in an anonymous namespace;
+// including it here tests the very code the example library is built from.
+#include "examples/third_party_rolling/epsd.cpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -496,4 +505,111 @@ TEST(RollingKernel, MixedPairBatchIsSplitIntoRunsOfOnePair) {
     EXPECT_EQ(one.tqz[0], mixed.tqz[c]) << c;
   }
   Export::destroy(inst);
+}
+
+// The example's two stiffness options and its dashpot switch (LIGGGHTS epsd:
+// ai + dashpot, epsd2: iwashita_oda without), driven at a constant rolling
+// angular velocity until the cap: the elastic law M = -(k_r theta_r +
+// C_r omega_r), then |M| = mu_r R* F_n opposing omega_r, with the ABI outputs
+// rolling_stiffness = k_r and rolling_damping = C_r.
+TEST(EpsdExample, StiffnessOptionsAndDashpotSwitchFollowTheFormulas) {
+  const double mu_r = 0.1, eta_r = 0.3, dt = 1e-5;
+  const double g_eff = 5e6 / (4.0 * (2.0 - 0.3) * (1.0 + 0.3));  // G* of two E = 5 MPa, nu = 0.3 spheres
+  for (const char* stiffness : {"ai", "iwashita_oda"})
+    for (const bool dashpot : {true, false}) {
+      json params = {{"rolling_friction", mu_r}, {"stiffness", stiffness}, {"dashpot", dashpot}};
+      if (dashpot) params["viscous_damping"] = eta_r;
+      const Epsd model{Params(params)};
+      const auto cases = sweep(0.0);
+      const uint32_t nc = static_cast<uint32_t>(cases.size());
+      Batch bt(nc);
+      bt.pair.shear_eff = g_eff;
+      std::vector<Case> scaled = cases;
+      std::vector<double> k_r(nc), c_r(nc), m_max(nc);
+      for (uint32_t c = 0; c < nc; ++c) {
+        Case& k = scaled[c];
+        const double delta = 1e-3 * k.r_eff;
+        k_r[c] = std::string(stiffness) == "ai" ? 2.25 * k.kn_secant * mu_r * mu_r * k.r_eff * k.r_eff
+                                                : 8.0 * g_eff * std::sqrt(k.r_eff * delta) * k.r_eff * k.r_eff;
+        // two spheres of radius 2 R*, masses 3e-5 and 1e-5 kg: I_r = 1.4 I_i I_j / (I_i + I_j), I = m R^2
+        const double ii = 3e-5 * 4.0 * k.r_eff * k.r_eff, ij = 1e-5 * 4.0 * k.r_eff * k.r_eff;
+        c_r[c] = dashpot ? eta_r * 2.0 * std::sqrt(1.4 * ii * ij / (ii + ij) * k_r[c]) : 0.0;
+        m_max[c] = mu_r * k.r_eff * k.fn_el;
+        // yield near step 1500: M_max = k_r |omega_r| dt steps
+        const double steps = m_max[c] / (k_r[c] * norm(in_plane(k.omega, k.n)) * dt);
+        for (auto& w : k.omega) w *= steps / 1500.0;
+      }
+      for (uint32_t c = 0; c < nc; ++c) {
+        const Case& k = scaled[c];
+        load(bt, c, k, dt);
+        bt.fn[c] = k.fn_el;  // the total normal force, the cap's F_n
+        bt.overlap[c] = 1e-3 * k.r_eff;
+        bt.contact_radius[c] = std::sqrt(k.r_eff * bt.overlap[c]);  // Hertz
+        bt.radius_i[c] = bt.radius_j[c] = 2.0 * k.r_eff;
+        bt.mass_i[c] = 3e-5;
+        bt.mass_j[c] = 1e-5;
+      }
+      std::vector<int> yielded_at(nc, -1);
+      for (int step = 1; step <= 3000; ++step) {
+        bt.clear_outputs();
+        model.compute(bt.b);
+        for (uint32_t c = 0; c < nc; ++c) {
+          const Case& k = scaled[c];
+          ASSERT_NEAR(bt.rolling_stiffness[c], k_r[c], 1e-14 * k_r[c]) << stiffness << " contact " << c;
+          ASSERT_NEAR(bt.rolling_damping[c], c_r[c], 1e-14 * c_r[c]) << stiffness << " contact " << c;
+          const V3 wr = in_plane(k.omega, k.n);
+          const V3 tq = bt.torque(c);
+          const double spring = k_r[c] * step * dt * norm(wr);
+          if (spring <= m_max[c] * (1 - 1e-9)) {
+            ASSERT_LT(yielded_at[c], 0) << "elastic again after yielding";
+            const double f = k_r[c] * step * dt + c_r[c];
+            for (int q = 0; q < 3; ++q)
+              ASSERT_NEAR(tq[q], -f * wr[q], 1e-11 * f * norm(wr)) << stiffness << " contact " << c << " step " << step;
+          } else if (spring > m_max[c] * (1 + 1e-9)) {
+            if (yielded_at[c] < 0) yielded_at[c] = step;
+            ASSERT_NEAR(norm(tq), m_max[c], 1e-12 * m_max[c]) << stiffness << " contact " << c << " step " << step;
+            ASSERT_NEAR(dot(tq, unit(wr)), -m_max[c], 1e-12 * m_max[c]) << "must oppose omega_r";
+          }
+        }
+      }
+      for (uint32_t c = 0; c < nc; ++c) EXPECT_GT(yielded_at[c], 1000) << stiffness << " contact " << c;
+    }
+}
+
+// epsd2's spring is much stiffer than epsd's at the same mu_r (§2.3 against
+// §2.2): k_t R*^2 / (2.25 k_n mu_r^2 R*^2) = 8 G* a / (2.25 (4/3) E* a mu_r^2)
+// for Hertz, 2.67 G*/(E* mu_r^2) = 55 at nu = 0.3 and mu_r = 0.1.
+TEST(EpsdExample, IwashitaOdaOverAiIsTheHertzMindlinStiffnessRatio) {
+  const double e_eff = 5e6 / (2.0 * (1.0 - 0.09)), g_eff = 5e6 / (4.0 * 1.7 * 1.3), mu_r = 0.1;
+  const double r = 1.4e-3, delta = 1e-5, a = std::sqrt(r * delta);
+  double k[2] = {0.0, 0.0};
+  for (int opt = 0; opt < 2; ++opt) {
+    const Epsd model{Params(json{{"rolling_friction", mu_r}, {"stiffness", opt ? "iwashita_oda" : "ai"}})};
+    Batch bt(1);
+    bt.pair.shear_eff = g_eff;
+    bt.set_normal(0, {0, 0, 1});
+    bt.r_eff[0] = bt.radius_i[0] = bt.radius_j[0] = r;
+    bt.overlap[0] = delta;
+    bt.contact_radius[0] = a;
+    bt.kn[0] = 4.0 / 3.0 * e_eff * a;  // Hertz secant stiffness
+    bt.fn[0] = bt.kn[0] * delta;
+    model.compute(bt.b);
+    k[opt] = bt.rolling_stiffness[0];
+  }
+  const double expected = 8.0 * g_eff / (2.25 * 4.0 / 3.0 * e_eff * mu_r * mu_r);
+  EXPECT_NEAR(k[1] / k[0], expected, 1e-12 * expected);
+  EXPECT_NEAR(expected, 55.0, 0.5);
+}
+
+TEST(EpsdExample, RefusesAnUnknownStiffnessAndADashpotContradiction) {
+  EXPECT_THROW(Epsd(Params(json{{"rolling_friction", 0.1}, {"stiffness", "iwashita"}})), ParameterError);
+  try {
+    Epsd(Params(json{{"rolling_friction", 0.1}, {"dashpot", false}, {"viscous_damping", 0.3}}));
+    ADD_FAILURE() << "dashpot false with viscous_damping 0.3 was accepted";
+  } catch (const ParameterError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'viscous_damping'"), std::string::npos) << what;
+    EXPECT_NE(what.find("'dashpot' is false"), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(Epsd(Params(json{{"rolling_friction", 0.1}, {"dashpot", false}, {"viscous_damping", 0.0}})));
 }
