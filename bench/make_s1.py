@@ -65,10 +65,15 @@ ROLLING = {
     "none": {"model": "none"},
     "cdt": {"model": "dct", "rolling_friction": 0.1},
     "epsd2": {"model": "sd_critical_angle", "critical_angle": math.degrees(math.atan(0.1))},
+    # the same model in both codes: the out-of-tree example plugin (examples/third_party_rolling) set up as
+    # LIGGGHTS epsd2 (Iwashita-Oda stiffness, no dashpot); the scenario loads the library by its path
+    "epsd2_plugin": {"model": "epsd", "rolling_friction": 0.1, "stiffness": "iwashita_oda", "dashpot": False},
 }
+# the LIGGGHTS rolling model (settle.in's RF) each domel variant is compared with, where the key is not it
+PEER_RF = {"epsd2_plugin": "epsd2"}
 
 
-def scenario(n_requested, rolling="none"):
+def scenario(n_requested, rolling="none", plugins=None):
     nx, ny, nz = lattice_dims(n_requested)
     a = SPACING * D
     # rounded to 1e-12 m (far below the 1e-9 a slack of the site count) only to keep the JSON readable
@@ -76,6 +81,7 @@ def scenario(n_requested, rolling="none"):
     n_actual = nx * ny * nz
     return {
         "$schema": "../../docs/domel.schema.json",
+        **({"plugins": list(plugins)} if plugins else {}),
         "name": ("s1_settle_%s" % label(n_requested)) if rolling == "none" else
                 ("s2_settle_%s_%s" % (label(n_requested), ROLLING[rolling]["model"])),
         "description": (

@@ -167,7 +167,7 @@ def cpu_in_last(samples, window_s):
 
 def scenario_file(n, workdir, rolling="none"):
     """The committed bench/scenarios file for N when it exists and matches make_s1.py, else a fresh one."""
-    fresh = make_s1.scenario(n, rolling)
+    fresh = make_s1.scenario(n, rolling, DECK.get("plugins"))
     committed = os.path.join(HERE, "scenarios", fresh["name"] + ".json")
     if os.path.isfile(committed):
         with open(committed) as f:
@@ -211,6 +211,25 @@ def summary_final(s):
         res["neighbor_builds_total"] = sd.get("neighbor_list_builds")
         res["history_bytes"] = (sd.get("memory_bytes") or {}).get("contact_history")
     return res
+
+
+def build_epsd_example(domel, workdir):
+    """libdomel_rolling_epsd.so built as a third party builds it: the domel build tree of the --domel binary
+    installed into <workdir>/epsd-prefix, examples/third_party_rolling configured against that prefix only."""
+    build = os.path.dirname(os.path.dirname(os.path.realpath(domel)))
+    if not os.path.isfile(os.path.join(build, "CMakeCache.txt")):
+        sys.exit("run_s1.py: --rolling epsd2_plugin: %s is not in a CMake build tree (no %s); build the example "
+                 "(examples/third_party_rolling/README.md) and pass --epsd-library" %
+                 (domel, os.path.join(build, "CMakeCache.txt")))
+    prefix, out = os.path.join(workdir, "epsd-prefix"), os.path.join(workdir, "epsd-build")
+    project = os.path.join(os.path.dirname(HERE), "examples", "third_party_rolling")
+    for cmd in (["cmake", "--install", build, "--prefix", prefix],
+                ["cmake", "-S", project, "-B", out, "-DCMAKE_BUILD_TYPE=Release", "-DCMAKE_PREFIX_PATH=" + prefix],
+                ["cmake", "--build", out]):
+        r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if r.returncode != 0:
+            sys.exit("run_s1.py: building the epsd example failed: %s\n%s" % (" ".join(cmd), r.stdout))
+    return os.path.join(out, "libdomel_rolling_epsd.so")
 
 
 def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
@@ -293,7 +312,7 @@ def run_liggghts(liggghts, deckdir, n, rep, workdir, timeout, env, rolling="none
         cmd = [liggghts, "-in", "bed.in", "-var", "data", make_bed.paths(DECK["bed_dir"], n)["data"]]
     else:
         cmd = [liggghts, "-in", "settle.in", "-var", "N", str(n)]
-    cmd += ["-var", "nsettle", str(nsettle), "-var", "nrun", str(nrun), "-var", "RF", rolling, "-log", log]
+    cmd += ["-var", "nsettle", str(nsettle), "-var", "nrun", str(nrun), "-var", "RF", make_s1.PEER_RF.get(rolling, rolling), "-log", log]
     if shutil.which("stdbuf"):  # LIGGGHTS dies silently when stdout is a file (RESULTS.md, problem 2)
         cmd = ["stdbuf", "-oL"] + cmd
     row["load1_start"] = load1()
@@ -448,6 +467,8 @@ def deck_title(deck, rolling):
         base = "Dense settled bed (bench/make_bed.py)"
         return base if rolling == "none" else base + " with rolling (LIGGGHTS %s vs domel %s)" % (
             rolling, make_s1.ROLLING[rolling]["model"])
+    if rolling == "epsd2_plugin":
+        return "S2 settle+rolling (LIGGGHTS epsd2 vs domel + the example plugin's epsd as epsd2, loaded by path)"
     return "S1 settle" if rolling == "none" else "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (
         rolling, make_s1.ROLLING[rolling]["model"])
 
@@ -498,7 +519,11 @@ def main(argv=None):
     ap.add_argument("--results", default=os.path.join(HERE, "results"), help="CSV folder (default bench/results)")
     ap.add_argument("--rolling", choices=sorted(make_s1.ROLLING), default="none",
                     help="S1 (none, default) or S2: LIGGGHTS RF = cdt against domel dct (mu_r = 0.1), RF = epsd2 "
-                         "against domel sd_critical_angle (theta_c = atan 0.1)")
+                         "against domel sd_critical_angle (theta_c = atan 0.1), or epsd2_plugin: RF = epsd2 against "
+                         "the example plugin's epsd with the same model (Iwashita-Oda stiffness, no dashpot, "
+                         "mu_r = 0.1), loaded by path")
+    ap.add_argument("--epsd-library", help="with --rolling epsd2_plugin: the built libdomel_rolling_epsd.so (default: "
+                                           "build examples/third_party_rolling against the --domel build tree's SDK)")
     ap.add_argument("--threads", type=int, nargs="+", default=[1],
                     help="domel thread counts to run (default 1; e.g. --threads 1 2); LIGGGHTS always runs serially")
     ap.add_argument("--deck", choices=["s1", "bed"], default="s1",
@@ -555,6 +580,15 @@ def main(argv=None):
             _, facts = make_bed.prepare(n, DECK["bed_dir"], args.domel, threads=max(args.threads))
             print("bed N = %d: %.2f contacts per particle, solid fraction %.3f at the end of the preparation"
                   % (n, facts["contacts_per_particle_prep"], facts["solid_fraction_lower80"]))
+
+    if args.rolling == "epsd2_plugin":
+        if args.deck != "s1":
+            ap.error("--rolling epsd2_plugin runs on the s1 deck only")
+        lib = os.path.abspath(args.epsd_library) if args.epsd_library else build_epsd_example(args.domel, workdir)
+        if not os.path.isfile(lib):
+            ap.error("--epsd-library: no file %s" % lib)
+        DECK["plugins"] = [lib]
+        print("epsd example plugin: %s" % lib)
 
     info = machine_info()
     deck = deck_title(args.deck, args.rolling)
