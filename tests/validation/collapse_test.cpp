@@ -7,11 +7,16 @@
 // about the contact normal, docs/validation/repose.md):
 //  - S–D (sd_critical_angle): keeps decaying once positions are static: at
 //    least tenfold over the last 0.5 s (measured ~200x at dt = 1e-5 s).
-//  - DCT (mu_r = tan theta_c): stalls at a chatter floor that does not decay
-//    (measured last/first ratio ~0.6 over the last 0.5 s) and that falls when
-//    dt is halved (the chatter kick is M_r dt / I; measured: window mean of
-//    the median 0.6-0.7x at dt/2, so "roughly halves" holds only loosely).
-//  - the S–D result does not depend on dt: no floor at either step.
+//  - DCT (mu_r = tan theta_c): stalls, at both time steps: the median falls
+//    by well under tenfold over the last 0.5 s (measured last/first ~0.6).
+//    What it stalls at is not a floor set by the per-step kick M_r dt / I:
+//    run to 4 s at dt = 1e-5, 5e-6 and 2.5e-6 s (scenarios/ab/dct_floor.py,
+//    docs/validation/collapse_sd_vs_dct/report.md) the median keeps falling
+//    slowly, with bursts, to ~1e-4 rad/s, and the three steps give the same
+//    level within their run-to-run scatter. So nothing here asserts a
+//    dependence on dt; the dt/2 runs check that the S–D/DCT difference
+//    holds at both steps.
+//  - the S–D result does not depend on dt: it keeps decaying at either step.
 // Label "slow": four runs of 1.5 s simulated, ~6 min on one core.
 #include "support/fixture.hpp"
 
@@ -65,18 +70,20 @@ TEST(CollapseSdVsDct, SpringDashpotComesToRestConstantTorqueKeepsChattering) {
   const Series sd_half = run("sd_critical_angle", 5e-6), dct_half = run("dct", 5e-6);
   const double sd_early = sd.mean_median(0.95, 1.05), sd_late = sd.mean_median(1.45, 1.5);
   const double dct_early = dct.mean_median(0.95, 1.05), dct_late = dct.mean_median(1.45, 1.5);
+  const double sd_half_early = sd_half.mean_median(0.95, 1.05), sd_half_late = sd_half.mean_median(1.45, 1.5);
+  const double dct_half_early = dct_half.mean_median(0.95, 1.05), dct_half_late = dct_half.mean_median(1.45, 1.5);
   const double dct_floor = dct.mean_median(1.0, 1.5), dct_half_floor = dct_half.mean_median(1.0, 1.5);
-  std::printf("S-D  median |omega|: %.3g (t~1.0) -> %.3g (t~1.5)  [dt/2: %.3g]\n", sd_early, sd_late,
-              sd_half.mean_median(1.45, 1.5));
-  std::printf("DCT  median |omega|: %.3g (t~1.0) -> %.3g (t~1.5); floor %.3g, at dt/2 %.3g (ratio %.2f)\n",
-              dct_early, dct_late, dct_floor, dct_half_floor, dct_half_floor / dct_floor);
+  std::printf("S-D  median |omega|: %.3g (t~1.0) -> %.3g (t~1.5); at dt/2 %.3g -> %.3g\n", sd_early, sd_late,
+              sd_half_early, sd_half_late);
+  std::printf("DCT  median |omega|: %.3g (t~1.0) -> %.3g (t~1.5); at dt/2 %.3g -> %.3g; window means %.3g, at dt/2 "
+              "%.3g\n", dct_early, dct_late, dct_half_early, dct_half_late, dct_floor, dct_half_floor);
   EXPECT_LT(sd_late, 0.1 * sd_early) << "S-D must keep decaying, at least tenfold over the last 0.5 s";
-  EXPECT_GT(dct_late, 0.3 * dct_early) << "DCT should stall at a chatter floor";
-  EXPECT_LT(dct_half_floor, 0.85 * dct_floor) << "the DCT floor should fall with dt";
-  EXPECT_GT(dct_half_floor, 0.3 * dct_floor);
-  // no floor for S–D at either step: both end far below the DCT floor
+  EXPECT_LT(sd_half_late, 0.1 * sd_half_early) << "S-D at dt/2";
+  EXPECT_GT(dct_late, 0.3 * dct_early) << "DCT should stall";
+  EXPECT_GT(dct_half_late, 0.3 * dct_half_early) << "DCT at dt/2";
+  // S–D ends far below the level DCT stalls at, at either step
   EXPECT_LT(sd_late, 0.01 * dct_floor);
-  EXPECT_LT(sd_half.mean_median(1.45, 1.5), 0.01 * dct_half_floor);
+  EXPECT_LT(sd_half_late, 0.01 * dct_half_floor);
 }
 
 // Guards issue 3, acceptance 6(e): the angle-of-repose probe (free-surface fit
