@@ -466,11 +466,9 @@ def deck_title(deck, rolling):
     if deck == "bed":
         base = "Dense settled bed (bench/make_bed.py)"
         return base if rolling == "none" else base + " with rolling (LIGGGHTS %s vs domel %s)" % (
-            rolling, make_s1.ROLLING[rolling]["model"])
-    if rolling == "epsd2_plugin":
-        return "S2 settle+rolling (LIGGGHTS epsd2 vs domel + the example plugin's epsd as epsd2, loaded by path)"
+            make_s1.PEER_RF.get(rolling, rolling), make_s1.ROLLING[rolling]["model"])
     return "S1 settle" if rolling == "none" else "S2 settle+rolling (LIGGGHTS %s vs domel %s)" % (
-        rolling, make_s1.ROLLING[rolling]["model"])
+        make_s1.PEER_RF.get(rolling, rolling), make_s1.ROLLING[rolling]["model"])
 
 
 def report(csv_path):

@@ -29,7 +29,7 @@
 //  - k_n is the normal model's secant stiffness `kn` = F_el/delta, which is
 //    what LIGGGHTS hands the rolling model (cdata.kn, 4/3 E* sqrt(R* delta)
 //    for Hertz).
-//  - k_t is the Mindlin tangential stiffness 8 G* a, with a the contact
+//  - k_t is the Mindlin tangential stiffness 8 G* a (physics.md §1.1), with a the contact
 //    radius the normal stage writes (sqrt(R* delta) for Hertz) and G* the
 //    pair's shear_eff: what domel's `mindlin` stage uses and LIGGGHTS hands
 //    epsd2 (cdata.kt, 8 G* sqrt(R* delta)). The batch does not carry the
@@ -85,7 +85,7 @@ class Epsd {
   explicit Epsd(const domel::sdk::Params& p)
       : mu_r_(p.number("rolling_friction")),
         eta_r_(p.number_or("viscous_damping", 0.0)),
-        iwashita_oda_(p.string_or("stiffness", "ai") == "iwashita_oda"),
+        iwashita_oda_(iwashita_oda(p)),
         dashpot_(p.boolean_or("dashpot", true)) {
     // The schema already says all this; the constructor also refuses NaN and
     // guards a host that did not validate.
@@ -93,10 +93,6 @@ class Epsd {
       throw domel::sdk::ParameterError("epsd: 'rolling_friction' must be a number >= 0");
     if (!(eta_r_ >= 0.0))
       throw domel::sdk::ParameterError("epsd: 'viscous_damping' must be a number >= 0");
-    const std::string stiffness = p.string_or("stiffness", "ai");
-    if (stiffness != "ai" && stiffness != "iwashita_oda")
-      throw domel::sdk::ParameterError("epsd: 'stiffness' must be \"ai\" or \"iwashita_oda\", found \"" + stiffness +
-                                       "\"");
     if (!dashpot_ && eta_r_ > 0.0) {
       std::ostringstream what;
       what << "epsd: 'viscous_damping' is " << eta_r_
@@ -155,6 +151,16 @@ class Epsd {
   }
 
  private:
+  // "stiffness": true for "iwashita_oda", false for "ai" (the default);
+  // anything else is refused.
+  static bool iwashita_oda(const domel::sdk::Params& p) {
+    const std::string stiffness = p.string_or("stiffness", "ai");
+    if (stiffness != "ai" && stiffness != "iwashita_oda")
+      throw domel::sdk::ParameterError("epsd: 'stiffness' must be \"ai\" or \"iwashita_oda\", found \"" + stiffness +
+                                       "\"");
+    return stiffness == "iwashita_oda";
+  }
+
   // I_r = 1.4 (m_i R_i^2)(m_j R_j^2) / (m_i R_i^2 + m_j R_j^2)   (3-D, physics §2.2),
   // from the batch's masses and radii; a wall (mass_j = 0): I_r = 1.4 m_i R_i^2.
   // Equal spheres: 0.7 m R^2.

@@ -32,8 +32,9 @@ import math
 import os
 import sys
 
-D = 0.0028
-SPACING = 1.02
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_repose import D, SPACING, collapse_deck  # noqa: E402  (same folder: the repose deck's builder)
+
 FLOOR_R = 0.28
 MODELS = {
     "sd5": {"model": "sd_critical_angle", "critical_angle": math.degrees(math.atan(0.1))},
@@ -43,14 +44,12 @@ MODELS = {
 }
 
 
-def lattice_sites(radius, height, a, d):
-    """Sites of a simple-cubic lattice (constant a, anchored at the origin) whose sphere of diameter d lies in the
-    cylinder of this radius from z = 0 to height (as plugins/insertion/lattice.hpp counts them)."""
+def sites_per_layer(radius, a, d):
+    """Sites of one layer of a simple-cubic lattice (constant a, anchored at the origin) whose sphere of diameter d
+    lies inside this radius (as plugins/insertion/lattice.hpp counts them)."""
     n = int(math.ceil(radius / a)) + 1
-    per_layer = sum(1 for i in range(-n, n) for j in range(-n, n)
-                    if math.hypot((i + 0.5) * a, (j + 0.5) * a) + 0.5 * d <= radius)
-    layers = int(math.floor(height / a + 1e-9))
-    return per_layer, layers
+    return sum(1 for i in range(-n, n) for j in range(-n, n)
+               if math.hypot((i + 0.5) * a, (j + 0.5) * a) + 0.5 * d <= radius)
 
 
 def column_radius(n1, aspect):
@@ -59,49 +58,23 @@ def column_radius(n1, aspect):
 
 
 def scenario(model, alpha, seed, n1, duration, aspect):
-    RC = column_radius(n1, aspect)
+    rc = column_radius(n1, aspect)
     dp, a = alpha * D, SPACING * alpha * D
-    # radius of the region that keeps whole spheres inside the cylinder wall (as make_repose.py)
-    r_region = RC - 0.5 * a + 0.5 * dp
-    per_layer, _ = lattice_sites(r_region, 1.0, a, dp)
     target = int(round(n1 / alpha ** 3))
-    layers = int(math.ceil(target / per_layer))
-    floor_top = dp
-    doc = {
-        "$schema": "../../docs/domel.schema.json",
-        "name": "cg_heap_%s_a%g_s%d" % (model, alpha, seed),
-        "description": ("Coarse-grain invariance of the angle of repose (make_cg_heap.py): %d particles' worth of "
-                        "material at alpha = %g (%d parcels of %.2f mm) collapse from a cylinder of R = %.0f mm onto "
-                        "a rough floor of fixed parcels; rolling %s." % (
-                            n1, alpha, target, 1e3 * dp, 1e3 * RC, json.dumps(MODELS[model]))),
-        "gravity": [0, 0, -9.81],
-        "materials": {"beads": {"density": 2500, "youngs_modulus": 5e6, "poisson_ratio": 0.3}},
-        "interactions": [{"materials": ["beads", "beads"], "restitution": 0.5, "friction": 0.5}],
-        "walls": [
-            {"name": "box", "type": "box", "material": "beads", "min": [-0.32, -0.32, 0.0], "max": [0.32, 0.32, 0.5],
-             "open": ["zmax"]},
-            {"name": "cylinder", "type": "cylinder", "material": "beads", "axis": "z", "center": [0, 0, 0],
-             "radius": RC, "bottom": 0.0, "top": 0.5, "closed_bottom": False, "remove_at": 0.3},
-        ],
-        "subdomains": [{
-            "name": "heap", "material": "beads", "coarse_grain": alpha,
-            "contact": {"normal": {"model": "hertz"}, "damping": {"model": "restitution"},
-                        "tangential": {"model": "mindlin"}, "rolling": dict(MODELS[model])},
-            "time_step": "auto", "skin": 0.5,
-            "insert": [
-                {"model": "lattice", "fixed": True, "diameter": D, "spacing": 1.0, "origin": [0, 0, 0],
-                 "region": {"cylinder": {"axis": "z", "center": [0, 0, 0], "radius": FLOOR_R,
-                                         "bottom": 0.0, "top": floor_top}}},
-                {"model": "lattice", "diameter": D, "spacing": SPACING, "jitter": 0.005, "origin": [0, 0, 0],
-                 "seed": seed, "count": target,
-                 "region": {"cylinder": {"axis": "z", "center": [0, 0, 0], "radius": r_region,
-                                         "bottom": a, "top": (layers + 1.5) * a}}},
-            ],
-        }],
-        "run": {"duration": duration, "seed": 1},
-        "output": {"vtk_interval": 0.25, "probe_interval": 0.01, "repose_angle": {"base_height": floor_top},
-                   "state": True},
-    }
+    layers = int(math.ceil(target / sites_per_layer(rc - 0.5 * a + 0.5 * dp, a, dp)))
+    doc = collapse_deck(
+        "cg_heap_%s_a%g_s%d" % (model, alpha, seed),
+        "Coarse-grain invariance of the angle of repose (make_cg_heap.py): %d particles' worth of material at "
+        "alpha = %g (%d parcels of %.2f mm) collapse from a cylinder of R = %.0f mm onto a rough floor of fixed "
+        "parcels; rolling %s." % (n1, alpha, target, 1e3 * dp, 1e3 * rc, json.dumps(MODELS[model])),
+        dict(MODELS[model]), seed, column_top=(layers + 1.5) * a,
+        floor_region={"cylinder": {"axis": "z", "center": [0, 0, 0], "radius": FLOOR_R, "bottom": 0.0, "top": dp}},
+        parcel=dp, rc=rc, box=(0.32, 0.5), remove_at=0.3, duration=duration)
+    sd = doc["subdomains"][0]
+    sd["coarse_grain"] = alpha
+    sd["time_step"] = "auto"
+    sd["insert"][1]["count"] = target
+    doc["output"]["state"] = True
     return doc, target, target * alpha ** 3 / n1, layers * a
 
 

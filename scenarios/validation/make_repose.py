@@ -17,61 +17,33 @@ for the theta_c -> angle-of-repose curve of docs/rolling.md.
 Usage: make_repose.py [seed] [--epsd-library PATH] [--theta-c DEG [DEG ...]]"""
 import json, math, os, sys
 
-args = sys.argv[1:]
-library = None
-if "--epsd-library" in args:
-    k = args.index("--epsd-library")
-    if k + 1 >= len(args):
-        sys.exit("make_repose.py: --epsd-library needs the path of libdomel_rolling_epsd.so")
-    library = os.path.abspath(args[k + 1])
-    if not os.path.isfile(library):
-        sys.exit(f"make_repose.py: --epsd-library: no file {library}")
-    del args[k:k + 2]
-angles = []
-if "--theta-c" in args:
-    k = args.index("--theta-c")
-    rest = args[k + 1:]
-    n = 0
-    while n < len(rest) and rest[n].replace(".", "", 1).isdigit():
-        n += 1
-    if n == 0:
-        sys.exit("make_repose.py: --theta-c needs one or more angles in degrees")
-    angles = [float(x) for x in rest[:n]]
-    if any(not 0.0 <= x < 90.0 for x in angles):
-        sys.exit("make_repose.py: --theta-c angles must lie in [0, 90) degrees")
-    del args[k:k + 1 + n]
-
+D = 0.0028
+SPACING = 1.02
+RC = 0.033
 # the scenarios' description: the deck, without the generator's options
 DECK = " ".join(__doc__.split("Rolling resistance:")[0].split()).replace("Writes repose_{sd,dct,none}.json: ", "", 1)
-d = 0.0028
-a = 1.02 * d
-Rc = 0.033
-seed = int(args[0]) if args else 15485863
-suffix = f"_s{seed}" if args else ""
-models = {
-    "sd": {"model": "sd_critical_angle", "critical_angle": math.degrees(math.atan(0.1))},
-    "dct": {"model": "dct", "rolling_friction": 0.1},
-    "none": {"model": "none"},
-}
-for deg in angles:
-    models[f"sd_tc{deg:g}"] = ({"model": "none"} if deg == 0.0 else
-                               {"model": "sd_critical_angle", "critical_angle": deg})
-if library:
-    models["epsd2"] = {"model": "epsd", "rolling_friction": 0.1, "stiffness": "iwashita_oda", "dashpot": False}
-for tag, rolling in models.items():
-    doc = {
+
+
+def collapse_deck(name, description, rolling, seed, column_top, floor_region, parcel=D, rc=RC, box=(0.1, 0.1),
+                  plugins=None, remove_at=0.25, duration=1.25):
+    """A column of lattice spheres (d = D, constant SPACING parcel diameters) in a cylinder of radius rc, removed at
+    remove_at, collapsing onto a floor of fixed spheres (floor_region) in a box of half-width box[0] and height
+    box[1]; the repose deck's material and contact laws. parcel is the diameter after coarse-graining (D at
+    alpha = 1): it sets the column region's margins and the probe's base height."""
+    a = SPACING * parcel
+    return {
         "$schema": "../../docs/domel.schema.json",
-        "name": f"repose_{tag}{suffix}",
-        "description": DECK + " Rolling resistance: " + json.dumps(rolling) + ".",
-        **({"plugins": [library]} if tag == "epsd2" else {}),
+        "name": name,
+        "description": description,
+        **({"plugins": list(plugins)} if plugins else {}),
         "gravity": [0, 0, -9.81],
         "materials": {"beads": {"density": 2500, "youngs_modulus": 5e6, "poisson_ratio": 0.3}},
         "interactions": [{"materials": ["beads", "beads"], "restitution": 0.5, "friction": 0.5}],
         "walls": [
-            {"name": "box", "type": "box", "material": "beads", "min": [-0.1, -0.1, 0.0], "max": [0.1, 0.1, 0.1],
-             "open": ["zmax"]},
+            {"name": "box", "type": "box", "material": "beads", "min": [-box[0], -box[0], 0.0],
+             "max": [box[0], box[0], box[1]], "open": ["zmax"]},
             {"name": "cylinder", "type": "cylinder", "material": "beads", "axis": "z", "center": [0, 0, 0],
-             "radius": Rc, "bottom": 0.0, "top": 0.1, "closed_bottom": False, "remove_at": 0.25},
+             "radius": rc, "bottom": 0.0, "top": box[1], "closed_bottom": False, "remove_at": remove_at},
         ],
         "subdomains": [{
             "name": "heap", "material": "beads",
@@ -79,17 +51,65 @@ for tag, rolling in models.items():
                         "tangential": {"model": "mindlin"}, "rolling": rolling},
             "time_step": 1e-5, "skin": 0.5,
             "insert": [
-                {"model": "lattice", "fixed": True, "diameter": d, "spacing": 1.0, "origin": [0, 0, 0],
-                 "region": {"box": {"min": [-0.0953, -0.0953, 0.0], "max": [0.0953, 0.0953, d]}}},
-                {"model": "lattice", "diameter": d, "spacing": 1.02, "jitter": 0.005, "origin": [0, 0, 0],
+                {"model": "lattice", "fixed": True, "diameter": D, "spacing": 1.0, "origin": [0, 0, 0],
+                 "region": floor_region},
+                {"model": "lattice", "diameter": D, "spacing": SPACING, "jitter": 0.005, "origin": [0, 0, 0],
                  "seed": seed,
-                 "region": {"cylinder": {"axis": "z", "center": [0, 0, 0], "radius": Rc - 0.5 * a + 0.5 * d,
-                                         "bottom": a, "top": 16 * a}}},
+                 "region": {"cylinder": {"axis": "z", "center": [0, 0, 0], "radius": rc - 0.5 * a + 0.5 * parcel,
+                                         "bottom": a, "top": column_top}}},
             ],
         }],
-        "run": {"duration": 1.25, "seed": 1},
-        "output": {"vtk_interval": 0.25, "probe_interval": 0.01, "repose_angle": {"base_height": d}},
+        "run": {"duration": duration, "seed": 1},
+        "output": {"vtk_interval": 0.25, "probe_interval": 0.01, "repose_angle": {"base_height": parcel}},
     }
-    with open(f"repose_{tag}{suffix}.json", "w") as f:
-        json.dump(doc, f, indent=2)
-        f.write("\n")
+
+
+def main():
+    args = sys.argv[1:]
+    library = None
+    if "--epsd-library" in args:
+        k = args.index("--epsd-library")
+        if k + 1 >= len(args):
+            sys.exit("make_repose.py: --epsd-library needs the path of libdomel_rolling_epsd.so")
+        library = os.path.abspath(args[k + 1])
+        if not os.path.isfile(library):
+            sys.exit(f"make_repose.py: --epsd-library: no file {library}")
+        del args[k:k + 2]
+    angles = []
+    if "--theta-c" in args:
+        k = args.index("--theta-c")
+        rest = args[k + 1:]
+        n = 0
+        while n < len(rest) and rest[n].replace(".", "", 1).isdigit():
+            n += 1
+        if n == 0:
+            sys.exit("make_repose.py: --theta-c needs one or more angles in degrees")
+        angles = [float(x) for x in rest[:n]]
+        if any(not 0.0 <= x < 90.0 for x in angles):
+            sys.exit("make_repose.py: --theta-c angles must lie in [0, 90) degrees")
+        del args[k:k + 1 + n]
+
+    seed = int(args[0]) if args else 15485863
+    suffix = f"_s{seed}" if args else ""
+    models = {
+        "sd": {"model": "sd_critical_angle", "critical_angle": math.degrees(math.atan(0.1))},
+        "dct": {"model": "dct", "rolling_friction": 0.1},
+        "none": {"model": "none"},
+    }
+    for deg in angles:
+        models[f"sd_tc{deg:g}"] = ({"model": "none"} if deg == 0.0 else
+                                   {"model": "sd_critical_angle", "critical_angle": deg})
+    if library:
+        models["epsd2"] = {"model": "epsd", "rolling_friction": 0.1, "stiffness": "iwashita_oda", "dashpot": False}
+    for tag, rolling in models.items():
+        doc = collapse_deck(f"repose_{tag}{suffix}", DECK + " Rolling resistance: " + json.dumps(rolling) + ".",
+                            rolling, seed, column_top=16 * SPACING * D,
+                            floor_region={"box": {"min": [-0.0953, -0.0953, 0.0], "max": [0.0953, 0.0953, D]}},
+                            plugins=[library] if tag == "epsd2" else None)
+        with open(f"repose_{tag}{suffix}.json", "w") as f:
+            json.dump(doc, f, indent=2)
+            f.write("\n")
+
+
+if __name__ == "__main__":
+    main()

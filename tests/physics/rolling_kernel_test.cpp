@@ -514,7 +514,7 @@ TEST(RollingKernel, MixedPairBatchIsSplitIntoRunsOfOnePair) {
 // rolling_stiffness = k_r and rolling_damping = C_r.
 TEST(EpsdExample, StiffnessOptionsAndDashpotSwitchFollowTheFormulas) {
   const double mu_r = 0.1, eta_r = 0.3, dt = 1e-5;
-  const double g_eff = 5e6 / (4.0 * (2.0 - 0.3) * (1.0 + 0.3));  // G* of two E = 5 MPa, nu = 0.3 spheres
+  const double g_eff = 5e6 / (4.0 * (2.0 - 0.3) * (1.0 + 0.3));  // G* of two E = 5 MPa, nu = 0.3 spheres (physics.md §1.1)
   for (const char* stiffness : {"ai", "iwashita_oda"})
     for (const bool dashpot : {true, false}) {
       json params = {{"rolling_friction", mu_r}, {"stiffness", stiffness}, {"dashpot", dashpot}};
