@@ -821,6 +821,30 @@ void build_grids(Build& b) {
 
 /// The run's length and the outputs. Intervals without a schema default are
 /// fractions of the duration, so this runs once the macro step is known.
+void build_repose_probe(Build& b) {
+  const json& out = b.doc["output"];
+  if (!out.contains("repose_angle")) return;
+  const json& r = out["repose_angle"];
+  const std::string where = "/output/repose_angle";
+  ReposeProbeSettings rp;
+  rp.base_height = r["base_height"].get<double>();
+  rp.cell = r["cell"].get<double>();
+  rp.band_lo = r["band"][0].get<double>();
+  rp.band_hi = r["band"][1].get<double>();
+  if (!(rp.band_lo < rp.band_hi))
+    b.ck.add(where + "/band", "expected band[0] < band[1] (the fitted part of the heap's height), found [" +
+                                  r["band"][0].dump() + ", " + r["band"][1].dump() + "]");
+  rp.planar = r["shape"].get<std::string>() == "planar";
+  rp.axis = axis_index(member(r, "axis"));
+  if (const json* c = member(r, "crest")) {
+    if (!rp.planar)
+      b.ck.add(where + "/crest", "'crest' is the crest line of a planar heap, but shape is \"cone\"",
+               "add \"shape\": \"planar\", or remove 'crest'");
+    rp.crest = c->get<double>();
+  }
+  b.sim.repose_probe = rp;
+}
+
 void build_outputs(Build& b) {
   Simulation& sim = b.sim;
   const json& run = b.doc["run"];
@@ -836,15 +860,6 @@ void build_outputs(Build& b) {
   sim.write_state = out["state"].get<bool>();
   for (auto& g : sim.grid_setups)
     if (g.spec.write_interval < 0) g.spec.write_interval = sim.duration / 20.0;
-  if (out.contains("repose_angle")) {
-    const json& r = out["repose_angle"];
-    ReposeProbeSettings rp;
-    rp.base_height = r["base_height"].get<double>();
-    rp.cell = r["cell"].get<double>();
-    rp.band_lo = r["band"][0].get<double>();
-    rp.band_hi = r["band"][1].get<double>();
-    sim.repose_probe = rp;
-  }
 }
 
 }  // namespace
@@ -861,6 +876,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   if (b.sim.subdomains.size() == doc["subdomains"].size()) build_couplings(b);
   build_particle_flow(b);
   build_grids(b);
+  build_repose_probe(b);
   if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);
   build_outputs(b);
   return sim;

@@ -5,6 +5,7 @@
 #include "scenario/scenario.hpp"
 
 #include <sstream>
+#include <vector>
 
 namespace domel::platform {
 
@@ -185,13 +186,22 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       continue;
     }
     table(os, s, root);
-    if (std::string(b[0]) == "coupling")
-      for (const char* sub : {"region", "stress_control", "velocity_control"}) {
-        os << "### `couplings[]." << sub << "`\n\n";
+    // Nested objects whose keys get a table of their own: (block, path prefix, members).
+    const struct {
+      const char* block;
+      const char* prefix;
+      std::vector<const char*> members;
+    } nested[] = {{"coupling", "couplings[].", {"region", "stress_control", "velocity_control"}},
+                  {"output", "output.", {"repose_angle"}}};
+    for (const auto& n : nested) {
+      if (std::string(b[0]) != n.block) continue;
+      for (const char* sub : n.members) {
+        os << "### `" << n.prefix << sub << "`\n\n";
         const json& ss = s["properties"][sub];
         if (ss.contains("description")) os << ss["description"].get<std::string>() << "\n\n";
         table(os, ss, root);
       }
+    }
   }
   const std::pair<uint32_t, const char*> kinds[] = {
       {DOMEL_KIND_NORMAL, "Normal-force models (`contact.normal`)"},

@@ -18,6 +18,7 @@ std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSett
   }
   if (n < 10) return std::nullopt;
   xc /= n; yc /= n;
+  if (settings.planar && settings.crest) (settings.axis == 0 ? xc : yc) = *settings.crest;
   const double cs = settings.cell * dsum / n;
   std::map<std::pair<long, long>, double> top;
   for (std::size_t k = 0; k < s.size(); ++k) {
@@ -34,7 +35,8 @@ std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSett
   std::size_t m = 0;
   for (const auto& [key, h] : top) {
     if (!(h > settings.band_lo * hmax && h < settings.band_hi * hmax)) continue;
-    const double r = std::hypot((key.first + 0.5) * cs, (key.second + 0.5) * cs);
+    const double cx = (key.first + 0.5) * cs, cy = (key.second + 0.5) * cs;
+    const double r = !settings.planar ? std::hypot(cx, cy) : std::abs(settings.axis == 0 ? cx : cy);
     sr += r; sh += h; srr += r * r; srh += r * h;
     ++m;
   }
