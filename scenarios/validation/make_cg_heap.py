@@ -17,6 +17,10 @@ periodic boundaries yet). The probe fits the planar slope with its crest at the 
 "planar", crest 0). Why planar: the issue asks for a heap at least about 15 parcel diameters tall at alpha = 3; a
 cone that tall holds about 1.2 million particles at alpha = 1, the half planar heap about 100,000.
 
+--shrink k (slot only) divides every length of the slot and the column, not the particles, by k: at alpha = 1 the
+deck is then, counted in particle diameters, the alpha = k deck built of real particles (95040/k^3 of them). Comparing
+the two separates what coarse-graining changes from what a smaller heap changes.
+
 --geometry cone: the first deck (kept to reproduce its runs): N1 (--n1, default 100000) particles' worth of material
 on a simple-cubic lattice (a = 1.02 alpha d, jitter +-0.5 % of the parcel diameter) in a cylinder with the repose
 deck's aspect height/diameter (--aspect, default 0.65), removed at 0.3 s. The lattice fits fewer whole parcels into
@@ -29,7 +33,7 @@ heap would have no base to stand on.
 
 Models (--models): sd5 (sd_critical_angle, theta_c = 5.71 deg = atan 0.1), sd20 (theta_c = 20 deg), none, dct
 (mu_r = tan 5.71 deg). Usage:
-    make_cg_heap.py [--geometry slot|cone] [--alphas 1 2 3] [--models sd5 sd20 none dct] [--seeds 15485863 ...]
+    make_cg_heap.py [--geometry slot|cone] [--shrink 1|2|3|6] [--alphas 1 2 3] [--models sd5 sd20 none dct] [--seeds 15485863 ...]
                     [--duration 1.3] [--n1 100000] [--aspect 0.65] [--out DIR]
 """
 import argparse
@@ -70,19 +74,23 @@ SLOT_LENGTH = 0.8  # [m] floor and slot length along x: the particles that roll 
 SLOT_GATE_AT = 0.2  # [s] the gate is removed once the column has settled
 
 
-def slot_scenario(model, alpha, seed, duration):
+def slot_scenario(model, alpha, seed, duration, shrink=1):
     """The planar heap: a rectangular column against the back wall of a slot collapses along +x when its gate is
     removed. The slot's walls (back x = 0, sides y = 0 and y = W, gate) are frictionless, so they act as mirror
-    planes: the heap is one half of a symmetric planar heap of unbounded width, without periodic boundaries."""
-    nx, ny, nz = SLOT_CELLS
-    if any(n % alpha for n in SLOT_CELLS):
-        sys.exit("make_cg_heap.py: the slot holds whole parcels only for alpha dividing %s" % (SLOT_CELLS,))
+    planes: the heap is one half of a symmetric planar heap of unbounded width, without periodic boundaries.
+    shrink > 1 divides every length of the slot and the column (not the particles) by shrink: at alpha = 1 and
+    shrink k the deck is, in particle diameters, the alpha = k deck, with real particles."""
+    if any(n % shrink for n in SLOT_CELLS):
+        sys.exit("make_cg_heap.py: --shrink must divide the slot's cell counts %s" % (SLOT_CELLS,))
+    nx, ny, nz = (n // shrink for n in SLOT_CELLS)
+    if any(n % alpha for n in (nx, ny, nz)):
+        sys.exit("make_cg_heap.py: the slot holds whole parcels only for alpha dividing %s" % ((nx, ny, nz),))
     dp, a = alpha * D, SPACING * alpha * D
     cell1 = SPACING * D
     length, width, height = nx * cell1, ny * cell1, nz * cell1
     count = int(round(nx * ny * nz / alpha ** 3))
     doc = collapse_deck(
-        "cg_heap_slot_%s_a%g_s%d" % (model, alpha, seed),
+        "cg_heap_slot_%s%s_a%g_s%d" % ("k%d_" % shrink if shrink > 1 else "", model, alpha, seed),
         "Coarse-grain invariance of the angle of repose, planar heap (make_cg_heap.py --geometry slot): %d "
         "particles' worth of material at alpha = %g (%d parcels of %.2f mm) in a column %.0f mm long and %.0f mm "
         "tall against the back wall of a frictionless slot %.1f mm wide collapse along +x onto a rough floor of "
@@ -90,13 +98,13 @@ def slot_scenario(model, alpha, seed, duration):
             nx * ny * nz, alpha, count, 1e3 * dp, 1e3 * length, 1e3 * height, 1e3 * width, SLOT_GATE_AT,
             json.dumps(MODELS[model])),
         dict(MODELS[model]), seed, column_top=a + height,
-        floor_region={"box": {"min": [0.0, 0.0, 0.0], "max": [SLOT_LENGTH, width, dp]}},
+        floor_region={"box": {"min": [0.0, 0.0, 0.0], "max": [SLOT_LENGTH / shrink, width, dp]}},
         parcel=dp, remove_at=SLOT_GATE_AT, duration=duration)
     doc["materials"]["mirror"] = dict(doc["materials"]["beads"])
     doc["interactions"].append({"materials": ["beads", "mirror"], "restitution": 0.5, "friction": 0.0})
     doc["walls"] = [
         {"name": "slot", "type": "box", "material": "mirror", "min": [0.0, 0.0, 0.0],
-         "max": [SLOT_LENGTH, width, a + 1.5 * height], "open": ["zmax"]},
+         "max": [SLOT_LENGTH / shrink, width, a + 1.5 * height], "open": ["zmax"]},
         {"name": "gate", "type": "plane", "material": "mirror", "point": [length, 0.0, 0.0],
          "normal": [-1.0, 0.0, 0.0], "remove_at": SLOT_GATE_AT},
     ]
@@ -141,6 +149,8 @@ def main(argv=None):
                     help="simulated time in s (default: 1.3 slot, 2.0 cone)")
     ap.add_argument("--aspect", type=float, default=0.65, help="cone: column height / column diameter")
     ap.add_argument("--geometry", choices=["slot", "cone"], default="slot")
+    ap.add_argument("--shrink", type=int, default=1, choices=[1, 2, 3, 6],
+                    help="slot: divide the slot's lengths (not the particles) by this factor")
     ap.add_argument("--out", default=".")
     args = ap.parse_args(argv)
     if any(a < 1 for a in args.alphas):
@@ -150,7 +160,7 @@ def main(argv=None):
         for model in args.models:
             for seed in args.seeds:
                 if args.geometry == "slot":
-                    doc, n, mass_ratio, height = slot_scenario(model, alpha, seed, args.duration or 1.3)
+                    doc, n, mass_ratio, height = slot_scenario(model, alpha, seed, args.duration or 1.3, args.shrink)
                 else:
                     doc, n, mass_ratio, height = cone_scenario(model, alpha, seed, args.n1, args.duration or 2.0,
                                                                args.aspect)
