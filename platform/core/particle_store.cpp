@@ -23,6 +23,7 @@ void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, doub
   flags.push_back(fixed ? kFixed : 0);
   if (external_force_)
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->push_back(0.0);
+  for (auto& a : aux) a.push_back(0.0);
   ++layout_version;
 }
 

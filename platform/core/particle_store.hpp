@@ -28,6 +28,10 @@ struct ParticleStore {
   /// force reset. Empty until enable_external_force(); from then on it moves
   /// with the particles like every other array, and new particles get 0.
   std::vector<double> ext_fx, ext_fy, ext_fz;
+  /// Further per-particle values a module asks for with add_aux() (the fluid
+  /// coupling's linearised drag and velocity integral): each moves with the
+  /// particles like every other array, and new particles get 0.
+  std::vector<std::vector<double>> aux;
 
   /// A fixed particle is never moved (inverse mass and inertia 0, so the
   /// integrator leaves it at rest) but is a full contact partner with its real
@@ -43,6 +47,13 @@ struct ParticleStore {
     if (external_force_) return;
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->assign(size(), 0.0);
     external_force_ = true;
+  }
+
+  /// Append k zero-filled aux arrays; returns the index of the first.
+  std::size_t add_aux(std::size_t k) {
+    const std::size_t first = aux.size();
+    for (std::size_t a = 0; a < k; ++a) aux.emplace_back(size(), 0.0);
+    return first;
   }
 
   /// Incremented by every change of which particle sits in which slot (add,
@@ -86,6 +97,7 @@ struct ParticleStore {
     if (external_force_) {
       f(ext_fx); f(ext_fy); f(ext_fz);
     }
+    for (auto& a : aux) f(a);
   }
   template <class F>
   void for_each_array(F&& f) const {

@@ -108,6 +108,32 @@ fs::path CellGridVtkSeries::write(double time, const CellGrid& grid, const CellF
   return frames_.write(*writer, time);
 }
 
+FieldImageSeries::FieldImageSeries(fs::path directory, std::string basename)
+    : directory_(directory), frames_(std::move(directory), std::move(basename), "vti") {}
+
+fs::path FieldImageSeries::write(double time, const FieldImage& img) {
+  const std::size_t cells = static_cast<std::size_t>(img.cells[0]) * img.cells[1] * img.cells[2];
+  if (cells == 0) throw std::invalid_argument("FieldImageSeries::write: the grid has no cells");
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(static_cast<int>(img.cells[0]) + 1, static_cast<int>(img.cells[1]) + 1,
+                       static_cast<int>(img.cells[2]) + 1);
+  image->SetOrigin(img.origin[0], img.origin[1], img.origin[2]);
+  image->SetSpacing(img.spacing[0], img.spacing[1], img.spacing[2]);
+  vtkCellData* cd = image->GetCellData();
+  for (const auto& f : img.fields) {
+    std::vector<double> values(f.data, f.data + cells * static_cast<std::size_t>(f.components));
+    add_array(cd, f.name.c_str(), values, f.components, cells);
+  }
+  vtkNew<vtkDoubleArray> time_value;
+  time_value->SetName("TimeValue");
+  time_value->InsertNextValue(time);
+  image->GetFieldData()->AddArray(time_value);
+  ensure_directory(directory_);
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  return frames_.write(*writer, time);
+}
+
 namespace {
 
 int checked_axis(int axis) {

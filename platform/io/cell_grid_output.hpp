@@ -9,7 +9,9 @@
 
 #include "io/vtk_frames.hpp"
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -42,6 +44,37 @@ class CellGridVtkSeries {
  private:
   std::filesystem::path directory_;
   std::string basename_;
+  VtkFrames frames_;
+};
+
+/// A uniform grid's cell fields for FieldImageSeries: cell (ix, iy, iz) has
+/// index ix + nx (iy + ny iz); a field of c components holds c values per
+/// cell, interleaved.
+struct FieldImage {
+  std::array<std::uint32_t, 3> cells{0, 0, 0};
+  double origin[3] = {0, 0, 0};   ///< [m]
+  double spacing[3] = {0, 0, 0};  ///< [m]
+  struct Field {
+    std::string name;
+    int components = 1;
+    const double* data = nullptr;
+  };
+  std::vector<Field> fields;
+};
+
+/// ParaView series of any uniform grid's cell fields (a fluid coupler's):
+/// <dir>/<basename>_<000000>.vti plus <dir>/<basename>.pvd, written as
+/// CellGridVtkSeries writes its frames.
+class FieldImageSeries {
+ public:
+  FieldImageSeries(std::filesystem::path directory, std::string basename);
+  /// Throws std::invalid_argument when the grid has no cells, RuntimeError
+  /// when a file cannot be written. Returns the path of the .vti.
+  std::filesystem::path write(double time, const FieldImage& image);
+  std::size_t files_written() const { return frames_.size(); }
+
+ private:
+  std::filesystem::path directory_;
   VtkFrames frames_;
 };
 

@@ -363,6 +363,24 @@ void ModelInstance::exchange(domel_fluid_exchange_v1& ex) const {
   if (model_->fluid_coupler.exchange(handle_, &ex, err, sizeof err) != DOMEL_OK) fail("exchange", err);
 }
 
+bool ModelInstance::fluid_fields(domel_fluid_fields_v1& out) const {
+  if (model_->fluid_coupler.fields == nullptr) return false;
+  out = domel_fluid_fields_v1{};
+  out.struct_size = sizeof out;
+  char err[1024] = {0};
+  if (model_->fluid_coupler.fields(handle_, &out, err, sizeof err) != DOMEL_OK) fail("fields", err);
+  return true;
+}
+
+bool ModelInstance::fluid_limits(domel_fluid_limits_v1& out) const {
+  if (model_->fluid_coupler.limits == nullptr) return false;
+  out = domel_fluid_limits_v1{};
+  out.struct_size = sizeof out;
+  char err[1024] = {0};
+  if (model_->fluid_coupler.limits(handle_, &out, err, sizeof err) != DOMEL_OK) fail("limits", err);
+  return true;
+}
+
 void ModelInstance::insert(const domel_insert_request_v1& request, std::vector<double>& x,
                            std::vector<double>& y, std::vector<double>& z, std::vector<double>& r) const {
   std::size_t capacity = 4096;

@@ -124,6 +124,10 @@ class ModelInstance {
   void control(domel_control_step_v1& step) const;
   /// Run a fluid coupler's exchange of one coupling interval.
   void exchange(domel_fluid_exchange_v1& exchange) const;
+  /// A fluid coupler's fields (false: it provides none; ABI 2.2's optional callback).
+  bool fluid_fields(domel_fluid_fields_v1& out) const;
+  /// A fluid coupler's stability limit (false: it reports none).
+  bool fluid_limits(domel_fluid_limits_v1& out) const;
 
   struct HostContext;  ///< the instance's side of domel_host_v2 (plugin_registry.cpp)
 

@@ -845,6 +845,74 @@ void build_repose_probe(Build& b) {
   b.sim.repose_probe = rp;
 }
 
+/// fluid: the fluid_coupler instance, the levels that share the fluid and
+/// the coupling interval in whole macro steps. The FluidCoupling itself is
+/// made once the outputs are known (its default write interval).
+std::optional<FluidSpec> build_fluid(Build& b) {
+  if (!b.doc.contains("fluid")) return std::nullopt;
+  const json& fj = b.doc["fluid"];
+  Simulation& sim = b.sim;
+  FluidSpec spec;
+  const std::string model = fj["model"].get<std::string>();
+  const RegisteredModel* m = b.registry.find(DOMEL_KIND_FLUID_COUPLER, model);
+  if (m == nullptr) return std::nullopt;  // check_models reported it
+  std::vector<std::string> names;
+  for (const auto& sd : sim.subdomains) names.push_back(sd->name());
+  if (fj.contains("subdomains")) {
+    const json& list = fj["subdomains"];
+    for (std::size_t q = 0; q < list.size(); ++q) {
+      const std::string want = list[q].get<std::string>();
+      const auto it = std::find(names.begin(), names.end(), want);
+      if (it == names.end()) {
+        b.ck.add(idx("/fluid/subdomains", q), "unknown subdomain '" + want + "'", suggest(want, names));
+        continue;
+      }
+      const std::size_t k = static_cast<std::size_t>(it - names.begin());
+      if (std::find(spec.levels.begin(), spec.levels.end(), k) != spec.levels.end())
+        b.ck.add(idx("/fluid/subdomains", q), "subdomain '" + want + "' is listed twice");
+      else
+        spec.levels.push_back(k);
+    }
+  } else {
+    for (std::size_t k = 0; k < names.size(); ++k) spec.levels.push_back(k);
+  }
+  const double macro = sim.macro_step();
+  const double asked = fj["interval"].get<double>();
+  spec.interval_macro = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(asked / macro)));
+  spec.interval = static_cast<double>(spec.interval_macro) * macro;
+  if (std::abs(spec.interval - asked) > 1e-9 * asked)
+    spdlog::info("/fluid/interval: coupling interval {:.6g} s (asked {:.6g} s): {} macro step(s) of {:.4g} s, so "
+                 "that every exchange falls on a step of every level",
+                 spec.interval, asked, spec.interval_macro, macro);
+  spec.write_interval = fj.contains("write_interval") ? fj["write_interval"].get<double>() : -1.0;
+  for (int d = 0; d < 3; ++d) spec.gravity[d] = sim.gravity[d];
+  try {
+    spec.model = std::make_shared<ModelInstance>(*m, plugin_params(fj, DOMEL_KIND_FLUID_COUPLER), "/fluid");
+  } catch (const PluginError& e) {
+    b.ck.add("/fluid", e.what());
+    return std::nullopt;
+  }
+  // The coupler's limit from its initial state (inlet velocities, grid): an
+  // interval above it is refused before anything runs.
+  try {
+    domel_fluid_limits_v1 lim{};
+    if (spec.model->fluid_limits(lim) && lim.max_interval > 0 && spec.interval > lim.max_interval * (1 + 1e-9))
+      b.ck.add("/fluid/interval",
+               "expected a coupling interval of at most " + fmt_num(lim.max_interval) + " s (" +
+                   (lim.limit ? lim.limit : "the coupler's stability limit") + "), found " + fmt_num(spec.interval) +
+                   " s",
+               "shorten the interval, or let the coupler sub-step its fluid if it can");
+  } catch (const PluginError& e) {
+    b.ck.add("/fluid", e.what());
+  }
+  spec.one_level_per_call = b.registry.libraries()[m->library].abi_minor < 2;
+  spec.used = {{"model", model},
+               {"version", m->version},
+               {"library", b.registry.libraries()[m->library].name},
+               {"library_version", b.registry.libraries()[m->library].version}};
+  return spec;
+}
+
 void build_outputs(Build& b) {
   Simulation& sim = b.sim;
   const json& run = b.doc["run"];
@@ -877,8 +945,13 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_particle_flow(b);
   build_grids(b);
   build_repose_probe(b);
+  std::optional<FluidSpec> fluid = build_fluid(b);
   if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);
   build_outputs(b);
+  if (fluid) {
+    if (fluid->write_interval < 0) fluid->write_interval = sim->vtk_interval;
+    sim->fluid = std::make_unique<FluidCoupling>(std::move(*fluid), sim->subdomains);
+  }
   return sim;
 }
 

@@ -166,6 +166,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
                              {"pour", "Pour (`subdomains[].pour[]`)"},
                              {"deletion_region", "Deletion region (`deletion_regions[]`)"},
                              {"coupling", "Coupling between levels (`couplings[]`)"},
+                             {"fluid_model", "Fluid coupling, platform keys (`fluid`)"},
                              {"run", "Run (`run`)"},
                              {"output", "Output (`output`)"},
                              {"mass_flow_plane", "Mass-flow plane (`output.mass_flow[]`)"},
@@ -174,8 +175,8 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
     const json& s = root["$defs"][b[0]];
     os << "## " << b[1] << "\n\n";
     if (s.contains("description")) os << s["description"].get<std::string>() << "\n\n";
-    if (std::string(b[0]) == "insertion_model") {
-      table(os, platform_scenario_schema()["$defs"]["insertion_model"], root);
+    if (std::string(b[0]) == "insertion_model" || std::string(b[0]) == "fluid_model") {
+      table(os, platform_scenario_schema()["$defs"][b[0]], root);
       continue;
     }
     if (std::string(b[0]) == "region") {
@@ -210,7 +211,8 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       {DOMEL_KIND_ROLLING, "Rolling-resistance models (`contact.rolling`)"},
       {DOMEL_KIND_TWISTING, "Twisting-resistance models (`contact.twisting`)"},
       {DOMEL_KIND_INSERTION, "Insertion models (`insert[]`)"},
-      {DOMEL_KIND_CONTROLLER, "Controller models (`couplings[].stress_control`, `couplings[].velocity_control`)"}};
+      {DOMEL_KIND_CONTROLLER, "Controller models (`couplings[].stress_control`, `couplings[].velocity_control`)"},
+      {DOMEL_KIND_FLUID_COUPLER, "Fluid couplers (`fluid`)"}};
   for (const auto& [kind, title] : kinds) {
     os << "## " << title << "\n\n";
     bool any = false;

@@ -31,6 +31,7 @@ namespace {
 json platform_block_properties(uint32_t kind) {
   const json& defs = platform_scenario_schema()["$defs"];
   if (kind == DOMEL_KIND_INSERTION) return defs["insertion_model"]["properties"];
+  if (kind == DOMEL_KIND_FLUID_COUPLER) return defs["fluid_model"]["properties"];
   return json::object();
 }
 
@@ -55,6 +56,7 @@ json model_block_schema(const RegisteredModel& model) {
   };
   add_req("model");
   if (model.desc.kind == DOMEL_KIND_INSERTION) add_req("region");
+  if (model.desc.kind == DOMEL_KIND_FLUID_COUPLER) add_req("interval");
   s["required"] = req;
   s.erase("$schema");
   return s;
@@ -80,6 +82,7 @@ json composed_scenario_schema(const PluginRegistry& registry) {
   fill("rolling_model", DOMEL_KIND_ROLLING, true);
   fill("twisting_model", DOMEL_KIND_TWISTING, true);
   fill("insertion_model", DOMEL_KIND_INSERTION, false);
+  fill("fluid_model", DOMEL_KIND_FLUID_COUPLER, false);
   return schema;
 }
 
@@ -132,6 +135,8 @@ const RegisteredModel* check_model_block(Checker& ck, const PluginRegistry& regi
 json* member_mut(json& j, const char* key) { return const_cast<json*>(member(j, key)); }
 
 void check_models(Checker& ck, json& doc, const PluginRegistry& registry, const Filled& filled) {
+  if (json* fluid = member_mut(doc, "fluid"))
+    check_model_block(ck, registry, *fluid, "/fluid", DOMEL_KIND_FLUID_COUPLER, false, filled);
   json* sds = member_mut(doc, "subdomains");
   if (!sds || !sds->is_array()) return;
   for (std::size_t k = 0; k < sds->size(); ++k) {

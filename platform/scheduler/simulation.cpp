@@ -159,6 +159,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       for (auto& c : couplings) c->exchange(step.t, subdomains, walls, flow);
     });
   }
+  // The fluid exchange: all levels stand at the same time at a macro-step start.
+  if (fluid)
+    run_hooks.before.push_back([this](const MacroStep& step) {
+      if (fluid->due(step.index)) fluid->exchange(step.t, subdomains);
+    });
   // Walls that appear or disappear (an outlet plug) change the accessible
   // volume: recompute it when the set of active walls changes.
   std::vector<char> wall_active;
@@ -246,6 +251,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     if (m > 0)
       for (auto& c : couplings) c->write_grids(t, false);
+    if (fluid && m < stop) fluid->write_fields(t, false, out);
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
@@ -279,6 +285,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (probes) probes->flush();
   write_grids(static_cast<double>(m) * macro, true);
   for (auto& c : couplings) c->write_grids(static_cast<double>(m) * macro, true);
+  if (fluid) fluid->write_fields(static_cast<double>(m) * macro, true, out);
 
   result.macro_steps = m;
   result.simulated_time = static_cast<double>(m) * macro;
@@ -364,6 +371,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
         files["couplings"][c->spec().name] = {{"balance", c->spec().name + "_balance.csv"}};
     }
     summary["couplings"] = cj;
+  }
+  if (fluid) {
+    summary["fluid"] = fluid->summary();
+    if (summary["fluid"].contains("fields")) files["fluid"] = "fluid.pvd";
   }
   if (!flow.empty()) {
     flow.check_planes(subdomains);

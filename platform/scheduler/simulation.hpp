@@ -8,6 +8,7 @@
 #include "averaging/cell_grid.hpp"
 #include "coupling/coupling.hpp"
 #include "core/material.hpp"
+#include "fluid/fluid_coupling.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scheduler/particle_flow.hpp"
@@ -85,6 +86,9 @@ class Simulation {
   /// clock: every control_macro macro steps, after the flow's hooks.
   std::vector<std::unique_ptr<Coupling>> couplings;
   std::uint64_t control_macro = 0;
+  /// The fluid coupling (the scenario's `fluid` block), if any: an exchange
+  /// every spec().interval_macro macro steps, after the couplings' hook.
+  std::unique_ptr<FluidCoupling> fluid;
 
   /// Run to the end. Throws RuntimeError or PluginError on failure; every
   /// file written up to then is complete (written to a temporary name and renamed).

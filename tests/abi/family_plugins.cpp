@@ -15,9 +15,17 @@
 //  - abi_test_drag: F = 6 pi mu r (u_f - v) along x, times (1 - phi) of the
 //    particle's cell when a grid is given. A level without particles is
 //    reported through the host's error service, then refused.
+//  - abi_test_linear_drag (ABI 2.2): every particle of every level gets the
+//    linearised drag beta = m / relaxation_time towards the uniform "flow"
+//    (refreshed by the host every step) and the held force m "held"; it logs
+//    each level's first particle's interval-mean velocity; its limits
+//    callback reports "max_interval" (after the first exchange
+//    "max_interval_later" when given); its fields callback a 1x1x2 grid with
+//    the exchange count and the flow.
 #include <domel/sdk/plugin.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -107,6 +115,86 @@ class TestDrag {
   domel::sdk::Host host_;
 };
 
+class TestLinearDrag {
+ public:
+  static constexpr domel_kind kKind = DOMEL_KIND_FLUID_COUPLER;
+  static constexpr const char* kName = "abi_test_linear_drag";
+  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kSummary = "ABI test fluid coupler: linearised drag m/tau (u - v) and a held force";
+  static constexpr const char* kSchema = R"json({
+  "type": "object",
+  "properties": {
+    "relaxation_time": { "type": "number", "exclusiveMinimum": 0, "x-unit": "s", "description": "tau: beta = m / tau" },
+    "flow": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "uniform flow u" },
+    "held": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s^2", "description": "held force per unit mass" },
+    "max_interval": { "type": "number", "minimum": 0, "default": 0, "x-unit": "s", "description": "reported stable interval (0: none)" },
+    "max_interval_later": { "type": "number", "minimum": 0, "default": 0, "x-unit": "s", "description": "reported instead once an exchange has run (0: max_interval)" }
+  },
+  "required": ["relaxation_time"],
+  "additionalProperties": false
+})json";
+
+  explicit TestLinearDrag(const domel::sdk::Params& p)
+      : tau_(p.number("relaxation_time")), max_interval_(p.number_or("max_interval", 0.0)),
+        max_later_(p.number_or("max_interval_later", 0.0)), host_(p.host()) {
+    for (int d = 0; d < 3; ++d) {
+      u_[d] = p.json()["flow"][d].get<double>();
+      a_[d] = p.json()["held"][d].get<double>();
+    }
+  }
+
+  void exchange(domel_fluid_exchange_v1& ex) {
+    if (!(ex.host_flags & DOMEL_FLUID_HOST_DRAG) || !(ex.host_flags & DOMEL_FLUID_HOST_MEAN_VELOCITY))
+      throw std::runtime_error("the host offers no linearised drag or mean velocity");
+    ++calls_;
+    for (uint32_t L = 0; L < ex.level_count; ++L) {
+      domel_particles_v1& p = *ex.levels[L]->particles;
+      domel_fluid_drag_v1& drag = *ex.drag[L];
+      if (drag.n != p.n) throw std::runtime_error("drag arrays do not match the particles");
+      for (size_t k = 0; k < p.n; ++k) {
+        drag.beta[k] = p.mass[k] / tau_;
+        drag.ux[k] = u_[0], drag.uy[k] = u_[1], drag.uz[k] = u_[2];
+        p.fx[k] += p.mass[k] * a_[0], p.fy[k] += p.mass[k] * a_[1], p.fz[k] += p.mass[k] * a_[2];
+      }
+      if (p.n > 0) {
+        char line[160];
+        std::snprintf(line, sizeof line, "exchange %d t %.17g level %s v_mean_z %.17g v_z %.17g", calls_, ex.time,
+                      ex.levels[L]->name, ex.v_mean[L][2], p.vz[0]);
+        host_.debug(line);
+      }
+    }
+  }
+
+  void limits(domel_fluid_limits_v1& out) {
+    out.max_interval = calls_ > 0 && max_later_ > 0 ? max_later_ : max_interval_;
+    out.limit = "test limit";
+    out.solver_iterations = static_cast<uint32_t>(calls_);
+  }
+
+  void fields(domel_fluid_fields_v1& out) {
+    count_[0] = count_[1] = calls_;
+    for (int c = 0; c < 2; ++c)
+      for (int d = 0; d < 3; ++d) flow_[3 * c + d] = u_[d];
+    static const char* const names[] = {"exchanges", "velocity"};
+    static const char* const units[] = {"1", "m/s"};
+    static const uint32_t components[] = {1, 3};
+    data_[0] = count_;
+    data_[1] = flow_;
+    out.field_count = 2;
+    out.nx = 1, out.ny = 1, out.nz = 2;
+    for (int d = 0; d < 3; ++d) out.origin[d] = 0.0, out.spacing[d] = 0.5;
+    out.names = names, out.units = units, out.components = components, out.data = data_;
+  }
+
+ private:
+  double tau_, max_interval_, max_later_;
+  double u_[3], a_[3];
+  double count_[2] = {0, 0}, flow_[6] = {0, 0, 0, 0, 0, 0};
+  const double* data_[2] = {nullptr, nullptr};
+  int calls_ = 0;
+  domel::sdk::Host host_;
+};
+
 }  // namespace
 
-DOMEL_PLUGIN_LIBRARY("abi_families", "1.0.0", TestController, TestDrag)
+DOMEL_PLUGIN_LIBRARY("abi_families", "1.0.0", TestController, TestDrag, TestLinearDrag)

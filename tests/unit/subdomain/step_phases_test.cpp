@@ -204,6 +204,25 @@ TEST(BodyForces, ExternalForceFollowsItsParticleThroughReordering) {
   EXPECT_EQ(s.ext_fx.back(), 0.0);
 }
 
+TEST(BodyForces, AuxArraysFollowTheirParticleThroughReorderingAndSwapRemove) {
+  // A module's per-particle arrays (ParticleStore::add_aux; the fluid
+  // coupling's drag) move with the particles; new particles get 0.
+  domel::platform::ParticleStore s;
+  for (int k = 0; k < 4; ++k) s.add(10 + k, k, 0, 0, 0.1, 1000.0);
+  const std::size_t a = s.add_aux(2);
+  EXPECT_EQ(a, 0u);
+  EXPECT_EQ(s.add_aux(1), 2u);
+  for (int k = 0; k < 4; ++k) s.aux[a + 1][k] = 200.0 + k;
+  s.permute({3, 2, 1, 0});
+  EXPECT_EQ(s.aux[a + 1][0], 203.0);
+  s.swap_remove(0);  // the last (id 10) moves into slot 0
+  EXPECT_EQ(s.id[0], 10u);
+  EXPECT_EQ(s.aux[a + 1][0], 200.0);
+  s.add(20, 0, 0, 0, 0.1, 1000.0);
+  for (const auto& v : s.aux) ASSERT_EQ(v.size(), s.size());
+  EXPECT_EQ(s.aux[a + 1].back(), 0.0);
+}
+
 TEST(StepPhases, AFailingHookNamesItselfAndItsPlace) {
   auto sim = prepared(column(), 1);
   Subdomain& sd = *sim->subdomains[0];

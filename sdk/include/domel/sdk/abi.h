@@ -41,7 +41,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 2
-#define DOMEL_ABI_MINOR 1
+#define DOMEL_ABI_MINOR 2
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -327,27 +327,97 @@ typedef struct domel_controller_family_v1 {
 /* Fluid-coupler family                                                       */
 /* ------------------------------------------------------------------------ */
 
-/** One coupling exchange: the particle data of a level go to the fluid
- *  solver, the per-particle fluid force (drag, pressure gradient, ...) comes
- *  back in particles->fx, fy, fz. cells may be NULL when the level has no
- *  averaging grid. */
+/** The linearised drag of one level (ABI 2.2): the host refreshes
+ *  F_i = beta_i (u_i - v_i) with the particle's CURRENT velocity v_i at every
+ *  time step until the next exchange, so the drag stays stable however short
+ *  the particle's relaxation time m_i/beta_i is against the coupling
+ *  interval. The host zeroes the arrays before each exchange; a particle the
+ *  coupler leaves at beta 0 feels no refreshed drag. */
+typedef struct domel_fluid_drag_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  size_t n;                   /**< = the level's particles->n */
+  double* beta;               /**< [out] drag coefficient of the particle (a parcel: all it stands for)  [kg/s] */
+  double *ux, *uy, *uz;       /**< [out] fluid velocity the particle sees  [m/s] */
+} domel_fluid_drag_v1;
+
+/** One coupling exchange: the particle data of the levels that share the
+ *  fluid go to the fluid solver; the per-particle fluid force comes back
+ *  in two parts: particles->fx, fy, fz (added to; held constant until the
+ *  next exchange: pressure gradient and any force the coupler does not
+ *  linearise) and, when the host offers it, the linearised drag of
+ *  domel_fluid_drag_v1 (refreshed every step). `cells` of a level is NULL,
+ *  and so is its particles->cell: a coupler keeps its own grid. */
 typedef struct domel_fluid_exchange_v1 {
   uint32_t struct_size;
   uint32_t reserved;          /**< 0 */
   double time;                /**< simulated time  [s] */
-  double interval;            /**< coupling interval: time since the previous exchange  [s] */
-  domel_level_v1* level;
+  double interval;            /**< coupling interval: the time between exchanges  [s] */
+  domel_level_v1* level;      /**< levels[0] */
+  /* ABI 2.2 */
+  double gravity[3];          /**< the scenario's gravity  [m/s^2] */
+  uint32_t level_count;       /**< levels sharing this fluid (>= 1) */
+  uint32_t host_flags;        /**< DOMEL_FLUID_HOST_*: what the host offers in this call */
+  domel_level_v1* const* levels;
+  /** per level, when DOMEL_FLUID_HOST_DRAG: the linearised drag [out] */
+  domel_fluid_drag_v1* const* drag;
+  /** per level, when DOMEL_FLUID_HOST_MEAN_VELOCITY: 3 n values x0, y0, z0,
+   *  x1, ...: each particle's velocity averaged over the interval that ends
+   *  now (since its insertion for a newer particle; its current velocity on
+   *  the first exchange)  [m/s]. With it a coupler gives the fluid exactly
+   *  the momentum the refreshed drag gave the particles. */
+  const double* const* v_mean;
 } domel_fluid_exchange_v1;
+
+#define DOMEL_FLUID_HOST_DRAG 1u          /**< drag[] is there: the host refreshes beta (u - v) every step */
+#define DOMEL_FLUID_HOST_MEAN_VELOCITY 2u /**< v_mean[] is there */
 
 /* Called once per coupling interval, from one thread at a time. */
 typedef domel_status (*domel_fluid_exchange_fn)(void* instance, domel_fluid_exchange_v1* exchange, char* err,
                                                 size_t err_capacity);
+
+/** The coupler's own fields for output (ABI 2.2), cell-centred on a uniform
+ *  grid: cell (ix, iy, iz) has index ix + nx (iy + ny iz), as
+ *  domel_cell_grid_v1. The coupler owns the memory; it stays valid until the
+ *  next call into the instance. The host writes them as VTK image data. */
+typedef struct domel_fluid_fields_v1 {
+  uint32_t struct_size;
+  uint32_t field_count;       /**< [out] */
+  uint32_t nx, ny, nz;        /**< [out] cells per axis */
+  double origin[3];           /**< [out] lower corner of cell (0,0,0)  [m] */
+  double spacing[3];          /**< [out] cell edge lengths  [m] */
+  const char* const* names;   /**< [out] e.g. "void_fraction", "pressure", "velocity" */
+  const char* const* units;   /**< [out] e.g. "1", "Pa", "m/s" */
+  const uint32_t* components; /**< [out] 1 (scalar) or 3 (vector, interleaved x, y, z per cell) */
+  const double* const* data;  /**< [out] field k: nx ny nz components[k] values */
+} domel_fluid_fields_v1;
+
+/** What bounds the coupling (ABI 2.2): the host refuses to run a coupling
+ *  interval longer than max_interval, naming `limit`, and records the rest.
+ *  Called once right after create (the limit of the initial state: inlet
+ *  velocities, grid), when the host refuses the scenario before anything
+ *  runs, and after every exchange, when it stops the run. */
+typedef struct domel_fluid_limits_v1 {
+  uint32_t struct_size;
+  uint32_t solver_iterations; /**< [out] iterations of the last solve (0: none) */
+  double max_interval;        /**< [out] longest stable coupling interval at the current state  [s]; 0: no limit */
+  const char* limit;          /**< [out] which limit that is, e.g. "advective CFL |u| dt/dx <= 0.5" (static text) */
+  double solver_residual;     /**< [out] relative residual of the last solve (0: none)  [-] */
+} domel_fluid_limits_v1;
+
+typedef domel_status (*domel_fluid_fields_fn)(void* instance, domel_fluid_fields_v1* out, char* err,
+                                              size_t err_capacity);
+typedef domel_status (*domel_fluid_limits_fn)(void* instance, domel_fluid_limits_v1* out, char* err,
+                                              size_t err_capacity);
 
 /** Callbacks of the fluid_coupler family. */
 typedef struct domel_fluid_coupler_family_v1 {
   uint32_t struct_size;
   uint32_t reserved;                /**< 0 */
   domel_fluid_exchange_fn exchange; /**< required */
+  /* ABI 2.2; optional: NULL, or beyond struct_size, means not provided */
+  domel_fluid_fields_fn fields;     /**< the coupler's fields, for output */
+  domel_fluid_limits_fn limits;     /**< its stability limit, checked after every exchange */
 } domel_fluid_coupler_family_v1;
 
 /* ------------------------------------------------------------------------ */

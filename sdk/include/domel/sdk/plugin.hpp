@@ -23,6 +23,8 @@
 //   insertion       void insert(const domel_insert_request_v1&, domel::sdk::Inserted& out);
 //   controller      void control(domel_control_step_v1&);
 //   fluid_coupler   void exchange(domel_fluid_exchange_v1&);
+//                   optional: void fields(domel_fluid_fields_v1&);
+//                             void limits(domel_fluid_limits_v1&);
 //
 // Host services: `p.host()` in the constructor is the model's domel::sdk::Host
 // (keep a copy); host.info("...") logs under the model's name and scenario
@@ -43,6 +45,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace domel::sdk {
@@ -143,6 +146,20 @@ template <class M, class = void>
 struct reads_masses : std::true_type {};
 template <class M>
 struct reads_masses<M, std::void_t<decltype(M::kReadsMasses)>> : std::bool_constant<M::kReadsMasses> {};
+
+/// A fluid coupler may provide `void fields(domel_fluid_fields_v1&)` (its
+/// grid fields for output) and `void limits(domel_fluid_limits_v1&)` (its
+/// stable coupling interval); either is optional (abi.h, ABI 2.2).
+template <class M, class = void>
+struct has_fields : std::false_type {};
+template <class M>
+struct has_fields<M, std::void_t<decltype(std::declval<M&>().fields(std::declval<domel_fluid_fields_v1&>()))>>
+    : std::true_type {};
+template <class M, class = void>
+struct has_limits : std::false_type {};
+template <class M>
+struct has_limits<M, std::void_t<decltype(std::declval<M&>().limits(std::declval<domel_fluid_limits_v1&>()))>>
+    : std::true_type {};
 
 constexpr bool is_contact_kind(domel_kind k) {
   return k == DOMEL_KIND_NORMAL || k == DOMEL_KIND_DAMPING || k == DOMEL_KIND_TANGENTIAL ||
@@ -293,6 +310,32 @@ struct Export {
     }
   }
 
+  static domel_status fields(void* self, domel_fluid_fields_v1* out, char* err, std::size_t cap) {
+    if constexpr (has_fields<M>::value) {
+      return guarded(err, cap, "fluid fields", [&] {
+        static_cast<Instance<M>*>(self)->model.fields(*out);
+        return DOMEL_OK;
+      });
+    } else {
+      (void)self; (void)out;
+      write_message(err, cap, "no fields");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
+  static domel_status limits(void* self, domel_fluid_limits_v1* out, char* err, std::size_t cap) {
+    if constexpr (has_limits<M>::value) {
+      return guarded(err, cap, "fluid limits", [&] {
+        static_cast<Instance<M>*>(self)->model.limits(*out);
+        return DOMEL_OK;
+      });
+    } else {
+      (void)self; (void)out;
+      write_message(err, cap, "no limits");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
   /// The family table of M's kind.
   static const void* family() {
     if constexpr (is_contact_kind(M::kKind)) {
@@ -308,8 +351,9 @@ struct Export {
       return &t;
     } else {
       static_assert(M::kKind == DOMEL_KIND_FLUID_COUPLER, "a model's kKind must be a domel_kind");
-      static const domel_fluid_coupler_family_v1 t = {sizeof(domel_fluid_coupler_family_v1), 0u,
-                                                      &Export::exchange};
+      static const domel_fluid_coupler_family_v1 t = {
+          sizeof(domel_fluid_coupler_family_v1), 0u, &Export::exchange,
+          has_fields<M>::value ? &Export::fields : nullptr, has_limits<M>::value ? &Export::limits : nullptr};
       return &t;
     }
   }

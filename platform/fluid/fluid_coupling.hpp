@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: MIT
+// The fluid-coupler host (the scenario's `fluid` block): every coupling
+// interval, at a macro-step boundary where all levels stand at the same
+// time, the subdomains that share the fluid hand their particles to a
+// fluid_coupler plugin (abi.h, domel_fluid_exchange_v1) and get back, per
+// particle, a held force (pressure gradient and whatever the coupler does not
+// linearise) and a linearised drag beta (u - v). Between exchanges each
+// level's post_force hook adds  held + beta (u - v)  with the particle's
+// velocity of that step (the half-step velocity of velocity Verlet, as
+// LAMMPS' fix viscous reads it), so a drag whose relaxation time m/beta is
+// far shorter than the coupling interval stays stable; the same hook
+// integrates each particle's velocity over the interval for the next
+// exchange's mean velocity. At an exchange the force each particle carries
+// into the next step's first half kick is updated too (the old fluid force
+// taken out, the new one put in), so the new fluid state acts from the
+// exchange's instant. The coupler's grid fields are written as a
+// ParaView series of VTK image data.
+#pragma once
+
+#include "loader/plugin_registry.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace domel::platform {
+
+class Subdomain;
+
+namespace io {
+class FieldImageSeries;
+}
+
+struct FluidSpec {
+  std::string where = "/fluid";          ///< the block's JSON pointer, for messages
+  std::shared_ptr<ModelInstance> model;  ///< the fluid_coupler plugin instance
+  nlohmann::json used;                   ///< {model, version, library, library_version} for summary.json
+  std::vector<std::size_t> levels;       ///< subdomain indices sharing the fluid
+  std::uint64_t interval_macro = 1;      ///< exchange every this many macro steps
+  double interval = 0;                   ///< = interval_macro x the macro step [s]
+  double write_interval = 0;             ///< fields output interval [s]; 0: none
+  double gravity[3] = {0, 0, 0};         ///< [m/s^2]
+  /// The plugin was built for ABI 2.1, which knows one level per exchange
+  /// and no linearised drag: it is called once per level.
+  bool one_level_per_call = false;
+};
+
+class FluidCoupling {
+ public:
+  /// Gives each level's particles the coupling's per-particle arrays and
+  /// registers the post_force hook that applies the fluid force.
+  FluidCoupling(FluidSpec spec, std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  ~FluidCoupling();
+  FluidCoupling(const FluidCoupling&) = delete;
+  FluidCoupling& operator=(const FluidCoupling&) = delete;
+
+  const FluidSpec& spec() const { return spec_; }
+
+  /// Whether macro step `index` starts with an exchange.
+  bool due(std::uint64_t index) const { return index % spec_.interval_macro == 0; }
+
+  /// One exchange at time t. Throws RuntimeError naming the block when the
+  /// plugin fails, when its stable interval is shorter than the coupling
+  /// interval, or when a particle's drag relaxation time m/beta is shorter
+  /// than its level's time step.
+  void exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains);
+
+  /// Write the coupler's fields when due (or, `final`, at the end whatever
+  /// the interval) into <out>/fluid_<NNNNNN>.vti and fluid.pvd.
+  void write_fields(double t, bool final, const std::filesystem::path& out);
+
+  /// summary.json's "fluid" block: model, levels, interval, exchanges, time
+  /// spent in the plugin, the last limit and solver figures, the net fluid
+  /// force on each level at the last exchange.
+  nlohmann::json summary() const;
+
+ private:
+  // aux array offsets within each level's block (ParticleStore::aux)
+  // beta and u; the held force; the velocity integral and its time; the
+  // fluid force last applied (replaced in f at an exchange)
+  enum : std::size_t { kBeta, kUx, kUy, kUz, kFx, kFy, kFz, kSx, kSy, kSz, kSt, kLx, kLy, kLz, kArrays };
+  FluidSpec spec_;
+  std::vector<std::size_t> aux_;  ///< per level: the index of its first aux array
+  std::vector<std::string> names_;  ///< per level: the subdomain's name
+  std::uint64_t exchanges_ = 0;
+  double seconds_ = 0;
+  double next_write_ = 0;
+  bool has_limits_ = false;
+  domel_fluid_limits_v1 last_limits_{};
+  std::vector<std::array<double, 3>> net_force_;  ///< per level, at the last exchange [N]
+  std::unique_ptr<io::FieldImageSeries> fields_out_;
+};
+
+}  // namespace domel::platform
