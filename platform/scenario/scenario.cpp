@@ -42,8 +42,37 @@ const json& platform_scenario_schema() {
   return schema;
 }
 
+/// Replace every {"$ref": "#/$defs/<name>"} of a plugin's schema by the
+/// plugin's own definition (recursively, to a depth of 16), so that the
+/// schema can sit inside the scenario's, whose "$defs" are the platform's.
+void inline_plugin_refs(json& node, const json& defs, int depth = 0) {
+  if (depth > 16) return;
+  if (node.is_object()) {
+    if (auto it = node.find("$ref"); it != node.end() && it->is_string()) {
+      const std::string ref = it->get<std::string>();
+      const std::string prefix = "#/$defs/";
+      if (ref.rfind(prefix, 0) == 0 && defs.contains(ref.substr(prefix.size()))) {
+        json resolved = defs[ref.substr(prefix.size())];
+        for (auto& [k, v] : node.items())
+          if (k != "$ref") resolved[k] = v;
+        node = std::move(resolved);
+        inline_plugin_refs(node, defs, depth + 1);
+        return;
+      }
+    }
+    for (auto& [k, v] : node.items()) inline_plugin_refs(v, defs, depth);
+  } else if (node.is_array()) {
+    for (auto& v : node) inline_plugin_refs(v, defs, depth);
+  }
+}
+
 json model_block_schema(const RegisteredModel& model) {
   json s = model.schema.is_object() ? model.schema : json::object();
+  if (s.contains("$defs") && s["$defs"].is_object()) {
+    const json defs = s["$defs"];
+    s.erase("$defs");
+    inline_plugin_refs(s, defs);
+  }
   if (!s.contains("type")) s["type"] = "object";
   json props = s.contains("properties") && s["properties"].is_object() ? s["properties"] : json::object();
   const json platform_props = platform_block_properties(model.desc.kind);

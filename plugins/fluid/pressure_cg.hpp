@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: MIT
+// The built-in pressure solve: Eigen's conjugate gradient with an incomplete
+// Cholesky preconditioner on the SPD 7-point system of vans_solver.hpp,
+// warm-started from the previous correction. Adequate for the grids of the
+// validation cases (up to ~10^5 cells); its cost per cell grows with the grid
+// (docs/fluid.md, "Pressure solve"), which a multigrid back end removes.
+#pragma once
+
+#include "plugins/fluid/vans_solver.hpp"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/Sparse>
+
+#include <algorithm>
+#include <vector>
+
+namespace domel::plugins::fluid {
+
+class PressureCg {
+ public:
+  PressureCg(double tolerance, int max_iterations) : tol_(tolerance), max_(max_iterations) {}
+
+  SolveReport operator()(const PressureSystem& sys, std::vector<double>& x) {
+    const Eigen::Index n = static_cast<Eigen::Index>(sys.diag.size());
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(sys.diag.size() * 7);
+    // scaled by the diagonal's mean so that the tolerance is relative and
+    // the preconditioner's shift is well-sized
+    for (std::size_t r = 0; r < sys.diag.size(); ++r) {
+      t.emplace_back(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r), sys.diag[r]);
+      for (const auto& [c, v] : sys.off[r]) t.emplace_back(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c), v);
+    }
+    Eigen::SparseMatrix<double> A(n, n);
+    A.setFromTriplets(t.begin(), t.end());
+    Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(sys.rhs.data(), n);
+    if (last_.size() != n) last_ = Eigen::VectorXd::Zero(n);
+    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                             Eigen::IncompleteCholesky<double>>
+        cg;
+    // relative to |b|, but never below tol x the system's reference norm
+    const double bn = b.norm();
+    cg.setTolerance(bn > 0 ? tol_ * std::max(1.0, sys.reference_norm / bn) : tol_);
+    cg.setMaxIterations(max_);
+    Eigen::VectorXd sol = Eigen::VectorXd::Zero(n);
+    const bool trivial = bn <= tol_ * sys.reference_norm;
+    if (!trivial) {
+      cg.compute(A);
+      sol = cg.solveWithGuess(b, last_);
+    }
+    last_ = sol;
+    x.assign(sol.data(), sol.data() + n);
+    SolveReport rep;
+    rep.iterations = trivial ? 0 : static_cast<int>(cg.iterations());
+    rep.residual = trivial ? 0.0 : cg.error();
+    return rep;
+  }
+
+ private:
+  double tol_;
+  int max_;
+  Eigen::VectorXd last_;
+};
+
+}  // namespace domel::plugins::fluid

@@ -1,0 +1,486 @@
+// SPDX-License-Identifier: MIT
+// Fluid coupler "vans": the built-in unresolved CFD-DEM coupler. A gas (or
+// liquid) on a uniform staggered grid whose cells hold several parcels,
+// solved with the volume-averaged Navier-Stokes equations of model A
+// (vans_solver.hpp), coupled both ways with the particles of every level that
+// shares it. At each exchange:
+//   1. the particles' volume is spread over the cell centres with trilinear
+//      (cloud-in-cell) weights: the void fraction eps moves continuously as a
+//      particle crosses a cell face;
+//   2. each particle's drag coefficient beta (drag_laws.hpp; a parcel of
+//      ratio alpha: alpha^3 times the original particle's, with Re at d/alpha,
+//      unless coarse_grain_scaling is false) is computed with the fluid as it
+//      stands, and beta and beta v_mean are spread over the face grids with the
+//      same kind of weights: the exchange coefficient K of the fluid's
+//      semi-implicit drag;
+//   3. the fluid advances over the interval in `substeps` projection steps;
+//   4. the particles get back the new fluid velocity at their centre with
+//      beta (the host refreshes beta (u - v) every DEM step) and, held until
+//      the next exchange, the pressure-gradient force -V grad p (which holds
+//      buoyancy: p includes the hydrostatic part).
+// With "coupling": "one_way" steps 1-3 ignore the particles (eps = 1, K = 0).
+#pragma once
+
+#include "plugins/fluid/drag_laws.hpp"
+#include "plugins/fluid/mac_grid.hpp"
+#include "plugins/fluid/pressure_cg.hpp"
+#include "plugins/fluid/vans_solver.hpp"
+
+#include <domel/sdk/plugin.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace domel::plugins::fluid {
+
+class Vans {
+ public:
+  static constexpr domel_kind kKind = DOMEL_KIND_FLUID_COUPLER;
+  static constexpr const char* kName = "vans";
+  static constexpr const char* kVersion = "0.1.0";
+  static constexpr const char* kSummary =
+      "volume-averaged Navier-Stokes (model A) on a uniform staggered grid, semi-implicit drag, two-way";
+  static constexpr const char* kSchema = R"json({
+  "type": "object",
+  "description": "The built-in unresolved CFD-DEM coupler (docs/fluid.md): incompressible volume-averaged Navier-Stokes equations (Anderson-Jackson model A) on a uniform staggered grid, a pressure-correction projection per fluid step, trilinear void fraction, semi-implicit drag, pressure-gradient force.",
+  "properties": {
+    "grid": { "type": "object", "description": "the fluid's box and its cells (several parcel diameters wide)",
+      "properties": {
+        "min": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m", "description": "lower corner" },
+        "max": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m", "description": "upper corner" },
+        "cells": { "type": "array", "items": { "type": "integer", "minimum": 1 }, "minItems": 3, "maxItems": 3, "description": "cells along x, y, z" } },
+      "required": ["min", "max", "cells"], "additionalProperties": false },
+    "density": { "type": "number", "exclusiveMinimum": 0, "x-unit": "kg/m^3", "description": "fluid density rho_f (air: 1.2)" },
+    "viscosity": { "type": "number", "exclusiveMinimum": 0, "x-unit": "Pa s", "description": "dynamic viscosity mu (air: 1.8e-5)" },
+    "boundaries": { "type": "object", "default": {}, "description": "each side of the box: {\"type\": \"wall\"} (no slip, the default), {\"type\": \"slip_wall\"} (no shear: a plane of symmetry), {\"type\": \"velocity_inlet\", \"velocity\": [..], \"patch\": {\"min\": [..], \"max\": [..]}} (the patch optional: the whole side), or {\"type\": \"pressure_outlet\", \"pressure\": p}; at least one outlet",
+      "properties": {
+        "x_min": { "$ref": "#/$defs/side" }, "x_max": { "$ref": "#/$defs/side" },
+        "y_min": { "$ref": "#/$defs/side" }, "y_max": { "$ref": "#/$defs/side" },
+        "z_min": { "$ref": "#/$defs/side" }, "z_max": { "$ref": "#/$defs/side" } },
+      "additionalProperties": false },
+    "obstacles": { "type": "array", "default": [], "description": "blocked cells: a box {\"box\": {\"min\", \"max\"}} or a cylinder {\"cylinder\": {\"axis\", \"center\", \"radius\", \"min\", \"max\"}}; a cell is blocked when its centre lies inside, or, along an axis where the shape is thinner than a cell (a plate), when the cell's extent overlaps it",
+      "items": { "type": "object" } },
+    "drag": { "type": "object", "default": {}, "properties": {
+        "law": { "enum": ["schiller_naumann", "di_felice", "gidaspow", "beetstra"], "default": "di_felice", "description": "drag law (docs/physics.md §7): schiller_naumann a single sphere; di_felice, gidaspow (Ergun / Wen-Yu) and beetstra for suspensions and beds" },
+        "coarse_grain_scaling": { "type": "boolean", "default": true, "description": "a parcel of ratio alpha feels alpha^3 times the drag of one original particle of diameter d/alpha (Sakai & Koshizuka 2009); false: the drag of one sphere of the parcel's diameter (wrong for alpha > 1, for comparison)" } },
+      "additionalProperties": false },
+    "pressure_gradient_force": { "type": "boolean", "default": true, "description": "apply -V grad p to each particle (model A; it holds buoyancy)" },
+    "coupling": { "enum": ["two_way", "one_way"], "default": "two_way", "description": "one_way: the fluid ignores the particles (eps = 1, no drag on the fluid)" },
+    "void_fraction_min": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.3, "x-unit": "1", "description": "eps is clamped to at least this in the fluid equations and the drag laws" },
+    "substeps": { "type": "integer", "minimum": 1, "default": 1, "description": "fluid steps per coupling interval" },
+    "cfl": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5, "x-unit": "1", "description": "advective Courant number limit of a fluid step, sum_a |u_a| dt / dx_a (first-order upwind)" },
+    "initial_velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "fluid velocity at the start" },
+    "solver": { "type": "object", "default": {}, "properties": {
+        "tolerance": { "type": "number", "exclusiveMinimum": 0, "default": 1e-8, "x-unit": "1", "description": "relative residual of the pressure solve" },
+        "max_iterations": { "type": "integer", "minimum": 1, "default": 2000, "description": "iterations of the pressure solve" } },
+      "additionalProperties": false }
+  },
+  "required": ["grid", "density", "viscosity"],
+  "additionalProperties": false,
+  "$defs": {
+    "side": { "type": "object", "properties": {
+        "type": { "enum": ["wall", "slip_wall", "velocity_inlet", "pressure_outlet"] },
+        "velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m/s" },
+        "patch": { "type": "object", "properties": {
+            "min": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m" },
+            "max": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m" } },
+          "required": ["min", "max"], "additionalProperties": false },
+        "pressure": { "type": "number", "x-unit": "Pa" } },
+      "required": ["type"], "additionalProperties": false }
+  }
+})json";
+
+  explicit Vans(const sdk::Params& p) : host_(p.host()), cg_(1e-8, 2000) {
+    const nlohmann::json& j = p.json();
+    VansSolver::Settings s;
+    const auto& g = j.at("grid");
+    for (int d = 0; d < 3; ++d) {
+      const double lo = g["min"][d].get<double>(), hi = g["max"][d].get<double>();
+      const int n = g["cells"][d].get<int>();
+      if (!(hi > lo))
+        throw sdk::ParameterError("grid: max must exceed min along " + std::string(1, "xyz"[d]));
+      s.grid.lo[d] = lo;
+      s.grid.n[d] = n;
+      s.grid.h[d] = (hi - lo) / n;
+    }
+    s.rho = p.number("density");
+    s.mu = p.number("viscosity");
+    if (j.contains("initial_velocity"))
+      for (int d = 0; d < 3; ++d) s.initial_velocity[d] = j["initial_velocity"][d].get<double>();
+    const nlohmann::json bnd = j.value("boundaries", nlohmann::json::object());
+    for (int side = 0; side < 6; ++side) {
+      if (!bnd.contains(kSideNames[side])) continue;
+      const auto& b = bnd[kSideNames[side]];
+      Boundary& out = s.sides[side];
+      const std::string type = b.at("type").get<std::string>();
+      const std::string where = std::string("boundaries/") + kSideNames[side];
+      if (type == "velocity_inlet") {
+        out.type = Boundary::velocity_inlet;
+        if (!b.contains("velocity")) throw sdk::ParameterError(where + ": a velocity_inlet needs 'velocity'");
+        for (int d = 0; d < 3; ++d) out.velocity[d] = b["velocity"][d].get<double>();
+        if (b.contains("patch")) {
+          out.patch = true;
+          for (int d = 0; d < 3; ++d) {
+            out.patch_lo[d] = b["patch"]["min"][d].get<double>();
+            out.patch_hi[d] = b["patch"]["max"][d].get<double>();
+          }
+        }
+      } else if (type == "pressure_outlet") {
+        out.type = Boundary::pressure_outlet;
+        out.pressure = b.value("pressure", 0.0);
+      } else if (type == "slip_wall") {
+        out.type = Boundary::slip_wall;
+      }
+      if (type != "velocity_inlet" && (b.contains("velocity") || b.contains("patch")))
+        throw sdk::ParameterError(where + ": 'velocity' and 'patch' belong to a velocity_inlet, not a " + type);
+      if (type != "pressure_outlet" && b.contains("pressure"))
+        throw sdk::ParameterError(where + ": 'pressure' belongs to a pressure_outlet, not a " + type);
+    }
+    bool outlet = false;
+    for (const auto& b : s.sides) outlet = outlet || b.type == Boundary::pressure_outlet;
+    if (!outlet)
+      throw sdk::ParameterError(
+          "boundaries: no side is a pressure_outlet; one is needed to fix the pressure level (and to let the gas out)");
+    std::vector<std::uint8_t> blocked = block_cells(s.grid, j.value("obstacles", nlohmann::json::array()));
+    const nlohmann::json drag = j.value("drag", nlohmann::json::object());
+    law_ = *drag_law_from_name(drag.value("law", std::string("di_felice")));
+    scaling_ = drag.value("coarse_grain_scaling", true);
+    pressure_force_ = j.value("pressure_gradient_force", true);
+    two_way_ = j.value("coupling", std::string("two_way")) == "two_way";
+    eps_min_ = j.value("void_fraction_min", 0.3);
+    substeps_ = j.value("substeps", 1);
+    cfl_ = j.value("cfl", 0.5);
+    const nlohmann::json solver = j.value("solver", nlohmann::json::object());
+    cg_ = PressureCg(solver.value("tolerance", 1e-8), solver.value("max_iterations", 2000));
+    solver_ = std::make_unique<VansSolver>(s, std::move(blocked));
+    // every inlet must keep at least one open face
+    for (int side = 0; side < 6; ++side) {
+      if (s.sides[side].type != Boundary::velocity_inlet) continue;
+      const int a = side / 2;
+      std::size_t open = 0;
+      solver_->for_faces(a, [&](int i, int jj, int k, std::size_t f) {
+        const int idx[3] = {i, jj, k};
+        if (idx[a] == (side % 2 ? s.grid.n[a] : 0) && solver_->kind(a)[f] == FaceKind::inlet) ++open;
+      });
+      if (open == 0)
+        throw sdk::ParameterError(std::string("boundaries/") + kSideNames[side] +
+                                  ": the velocity inlet has no open face: its patch misses the side's cell centres, "
+                                  "or every cell behind it is blocked by an obstacle");
+    }
+  }
+
+  void exchange(domel_fluid_exchange_v1& ex) {
+    if (ex.struct_size < offsetof(domel_fluid_exchange_v1, v_mean) + sizeof(ex.v_mean) ||
+        !(ex.host_flags & DOMEL_FLUID_HOST_DRAG))
+      throw std::runtime_error("the host offers no linearised drag (domel ABI 2.2 or later is needed)");
+    if (!gravity_set_) {
+      // the solver's gravity and hydrostatic start need the scenario's gravity
+      VansSolver::Settings s = solver_->settings();
+      for (int d = 0; d < 3; ++d) s.gravity[d] = ex.gravity[d];
+      std::vector<std::uint8_t> blocked = solver_->blocked();
+      solver_ = std::make_unique<VansSolver>(s, std::move(blocked));
+      gravity_set_ = true;
+    }
+    VansSolver& f = *solver_;
+    const MacGrid& g = f.grid();
+    const double V = g.cell_volume();
+    // 1. void fraction
+    f.keep_old_void_fraction();
+    std::vector<double> phi(g.cells(), 0.0);
+    double dmax = 0;
+    for (uint32_t L = 0; L < ex.level_count; ++L) {
+      const domel_particles_v1& p = *ex.levels[L]->particles;
+      for (std::size_t k = 0; k < p.n; ++k) {
+        const double x[3] = {p.x[k], p.y[k], p.z[k]};
+        if (!g.contains(x)) {
+          std::ostringstream os;
+          os << "particle " << p.id[k] << " of '" << ex.levels[L]->name << "' at (" << x[0] << ", " << x[1] << ", "
+             << x[2] << ") m is outside the fluid grid; make the grid cover the particles' domain, or remove "
+             << "particles where they leave it (a deletion region)";
+          throw std::runtime_error(os.str());
+        }
+        dmax = std::max(dmax, 2 * p.radius[k]);
+        if (two_way_) deposit(-1, x, volume(p.radius[k]) / V, phi);
+      }
+    }
+    std::vector<double>& eps = f.eps_mut();
+    for (std::size_t c = 0; c < g.cells(); ++c) eps[c] = std::max(eps_min_, 1.0 - phi[c]);
+    if (exchanges_ == 0) f.keep_old_void_fraction();  // no d(eps)/dt at the start
+    if (!warned_resolution_ && dmax > 0 && std::min({g.h[0], g.h[1], g.h[2]}) < 3 * dmax) {
+      warned_resolution_ = true;
+      std::ostringstream os;
+      os << "cells of " << std::min({g.h[0], g.h[1], g.h[2]}) << " m are smaller than 3 parcel diameters (" << dmax
+         << " m): the unresolved CFD-DEM regime (void fraction and drag averaged over many particles per cell) "
+         << "does not hold there; use larger cells or smaller parcels";
+      host_.warn(os.str());
+    }
+    // 2. drag coefficients with the fluid as it stands; K and K u_s on the face grids
+    for (int a = 0; a < 3; ++a) {
+      std::fill(f.K_mut(a).begin(), f.K_mut(a).end(), 0.0);
+      std::fill(f.Ku_mut(a).begin(), f.Ku_mut(a).end(), 0.0);
+    }
+    if (two_way_)
+      for (uint32_t L = 0; L < ex.level_count; ++L) {
+        const domel_particles_v1& p = *ex.levels[L]->particles;
+        const double alpha = ex.levels[L]->coarse_grain;
+        const double* vm = (ex.host_flags & DOMEL_FLUID_HOST_MEAN_VELOCITY) ? ex.v_mean[L] : nullptr;
+        for (std::size_t k = 0; k < p.n; ++k) {
+          const double x[3] = {p.x[k], p.y[k], p.z[k]};
+          const double v[3] = {vm ? vm[3 * k] : p.vx[k], vm ? vm[3 * k + 1] : p.vy[k], vm ? vm[3 * k + 2] : p.vz[k]};
+          const double b = particle_beta(x, v, p.radius[k], alpha, nullptr);
+          for (int a = 0; a < 3; ++a) {
+            deposit(a, x, b / V, f.K_mut(a));
+            deposit(a, x, b * v[a] / V, f.Ku_mut(a));
+          }
+        }
+      }
+    // 3. the fluid over the interval
+    const double dt = ex.interval / substeps_;
+    for (int s = 0; s < substeps_; ++s) {
+      last_solve_ = f.step(dt, static_cast<double>(s) / substeps_, static_cast<double>(s + 1) / substeps_,
+                           std::ref(cg_));
+      iterations_ += last_solve_.iterations;
+    }
+    ++exchanges_;
+    // 4. forces back
+    std::array<std::vector<double>, 3> G;
+    for (int a = 0; a < 3; ++a) G[a] = f.pressure_gradient(a);
+    double vmax = 0;
+    std::size_t invalid = 0;
+    std::string regime;
+    for (uint32_t L = 0; L < ex.level_count; ++L) {
+      domel_particles_v1& p = *ex.levels[L]->particles;
+      domel_fluid_drag_v1& drag = *ex.drag[L];
+      const double alpha = ex.levels[L]->coarse_grain;
+      for (std::size_t k = 0; k < p.n; ++k) {
+        const double x[3] = {p.x[k], p.y[k], p.z[k]};
+        const double v[3] = {p.vx[k], p.vy[k], p.vz[k]};
+        vmax = std::max(vmax, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+        double uf[3];
+        Validity val{true, ""};
+        drag.beta[k] = particle_beta(x, v, p.radius[k], alpha, uf, &val);
+        drag.ux[k] = uf[0], drag.uy[k] = uf[1], drag.uz[k] = uf[2];
+        if (!val.ok) {
+          ++invalid;
+          if (regime.empty()) regime = val.regime;
+        }
+        if (pressure_force_) {
+          const double Vp = volume(p.radius[k]);
+          p.fx[k] -= Vp * interpolate(0, x, G[0]);
+          p.fy[k] -= Vp * interpolate(1, x, G[1]);
+          p.fz[k] -= Vp * interpolate(2, x, G[2]);
+        }
+      }
+    }
+    vmax_ = vmax;
+    if (invalid > 0 && !warned_validity_) {
+      warned_validity_ = true;
+      host_.warn(std::to_string(invalid) + " particle(s) at t = " + std::to_string(ex.time) + " s use the " +
+                 name(law_) + " drag law outside the range its source fitted: " + regime);
+    }
+  }
+
+  void fields(domel_fluid_fields_v1& out) {
+    const VansSolver& f = *solver_;
+    const MacGrid& g = f.grid();
+    velocity_.clear();
+    f.cell_velocity(velocity_);
+    eps_ = f.eps();
+    p_ = f.pressure();
+    K_.assign(g.cells(), 0.0);
+    blocked_.assign(g.cells(), 0.0);
+    for (int k = 0; k < g.n[2]; ++k)
+      for (int j = 0; j < g.n[1]; ++j)
+        for (int i = 0; i < g.n[0]; ++i) {
+          const std::size_t c = g.cell(i, j, k);
+          blocked_[c] = f.blocked()[c] ? 1.0 : 0.0;
+          for (int a = 0; a < 3; ++a) {
+            int hi[3] = {i, j, k};
+            hi[a] += 1;
+            K_[c] += (f.K(a)[g.face(a, i, j, k)] + f.K(a)[g.face(a, hi[0], hi[1], hi[2])]) / 6.0;
+          }
+        }
+    static const char* const names[] = {"void_fraction", "pressure", "velocity", "exchange_coefficient", "blocked"};
+    static const char* const units[] = {"1", "Pa", "m/s", "kg/(m^3 s)", "1"};
+    static const uint32_t components[] = {1, 1, 3, 1, 1};
+    data_[0] = eps_.data(), data_[1] = p_.data(), data_[2] = velocity_.data(), data_[3] = K_.data(),
+    data_[4] = blocked_.data();
+    out.field_count = 5;
+    out.nx = static_cast<uint32_t>(g.n[0]), out.ny = static_cast<uint32_t>(g.n[1]), out.nz = static_cast<uint32_t>(g.n[2]);
+    for (int d = 0; d < 3; ++d) out.origin[d] = g.lo[d], out.spacing[d] = g.h[d];
+    out.names = names, out.units = units, out.components = components, out.data = data_;
+  }
+
+  void limits(domel_fluid_limits_v1& out) {
+    const VansSolver& f = *solver_;
+    const MacGrid& g = f.grid();
+    const auto umax = f.max_speed();
+    double rate = 0, visc = 0;
+    for (int a = 0; a < 3; ++a) {
+      rate += umax[a] / g.h[a];
+      visc += 2.0 / (g.h[a] * g.h[a]);
+    }
+    const double nu = f.settings().mu / f.settings().rho;
+    double best = 0;
+    const char* why = "";
+    auto consider = [&](double lim, const char* what) {
+      if (lim > 0 && std::isfinite(lim) && (best == 0 || lim < best)) {
+        best = lim;
+        why = what;
+      }
+    };
+    consider(rate > 0 ? substeps_ * cfl_ / rate : 0.0,
+             "advective CFL: sum_a |u_a| dt/dx_a <= cfl per fluid step (substeps x the fluid step)");
+    consider(substeps_ / (nu * visc), "explicit viscous diffusion: nu dt sum_a 2/dx_a^2 <= 1 per fluid step");
+    const double hmin = std::min({g.h[0], g.h[1], g.h[2]});
+    consider(vmax_ > 0 ? 0.5 * hmin / vmax_ : 0.0,
+             "particles move at most half a cell per coupling interval (the void fraction's rate of change)");
+    out.max_interval = best;
+    out.limit = why;
+    out.solver_iterations = static_cast<uint32_t>(last_solve_.iterations);
+    out.solver_residual = last_solve_.residual;
+  }
+
+  const VansSolver& solver() const { return *solver_; }
+
+ private:
+  static double volume(double r) { return 4.0 / 3.0 * M_PI * r * r * r; }
+
+  /// Spread `value` from point x onto grid `axis` (-1 cells, else the face
+  /// grid of that axis) with trilinear weights renormalised over the nodes
+  /// that take part (fluid cells; free faces), so nothing is lost.
+  void deposit(int axis, const double x[3], double value, std::vector<double>& out) const {
+    const VansSolver& f = *solver_;
+    const Stencil st = stencil(f.grid(), axis, x);
+    double wsum = 0;
+    for (int q = 0; q < 8; ++q) wsum += takes_part(axis, st.node[q]) ? st.w[q] : 0.0;
+    if (wsum <= 0) return;  // all nodes blocked: the particle is inside an obstacle
+    for (int q = 0; q < 8; ++q)
+      if (takes_part(axis, st.node[q])) out[st.node[q]] += value * st.w[q] / wsum;
+  }
+
+  bool takes_part(int axis, std::size_t node) const {
+    const VansSolver& f = *solver_;
+    if (axis < 0) return f.blocked()[node] == 0;
+    const FaceKind k = f.kind(axis)[node];
+    return k == FaceKind::interior || k == FaceKind::outlet;
+  }
+
+  double interpolate(int axis, const double x[3], const std::vector<double>& field) const {
+    const Stencil st = stencil(solver_->grid(), axis, x);
+    double v = 0;
+    for (int q = 0; q < 8; ++q) v += st.w[q] * field[st.node[q]];
+    return v;
+  }
+
+  /// beta of a particle (a parcel: coarse-grain scaled) with the fluid's
+  /// velocity and void fraction at its centre; the velocity into uf if given.
+  double particle_beta(const double x[3], const double v[3], double r, double alpha, double* uf,
+                       Validity* val = nullptr) const {
+    const VansSolver& f = *solver_;
+    double u[3];
+    for (int a = 0; a < 3; ++a) u[a] = interpolate(a, x, f.u(a));
+    const double e = std::clamp(interpolate(-1, x, f.eps()), eps_min_, 1.0);
+    const double slip = std::sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
+                                  (u[2] - v[2]) * (u[2] - v[2]));
+    if (uf)
+      for (int a = 0; a < 3; ++a) uf[a] = u[a];
+    const auto& s = f.settings();
+    if (val) {
+      const double d = scaling_ ? 2 * r / alpha : 2 * r;
+      *val = validity(law_, e, reynolds(law_ == DragLaw::schiller_naumann ? 1.0 : e, s.rho, d, slip, s.mu));
+    }
+    return beta_parcel(law_, 2 * r, alpha, scaling_, e, slip, s.rho, s.mu);
+  }
+
+  static std::vector<std::uint8_t> block_cells(const MacGrid& g, const nlohmann::json& obstacles) {
+    std::vector<std::uint8_t> blocked(g.cells(), 0);
+    for (std::size_t q = 0; q < obstacles.size(); ++q) {
+      const auto& o = obstacles[q];
+      const std::string where = "obstacles/" + std::to_string(q);
+      double lo[3], hi[3];
+      int axis = -1;
+      double centre[3] = {0, 0, 0}, radius = 0;
+      if (o.contains("box")) {
+        for (int d = 0; d < 3; ++d) {
+          lo[d] = o["box"].at("min").at(d).get<double>();
+          hi[d] = o["box"].at("max").at(d).get<double>();
+        }
+      } else if (o.contains("cylinder")) {
+        const auto& c = o["cylinder"];
+        const std::string ax = c.at("axis").get<std::string>();
+        axis = ax == "x" ? 0 : ax == "y" ? 1 : ax == "z" ? 2 : -1;
+        if (axis < 0) throw sdk::ParameterError(where + "/cylinder/axis: expected \"x\", \"y\" or \"z\", found \"" + ax + "\"");
+        radius = c.at("radius").get<double>();
+        int m = 0;
+        for (int d = 0; d < 3; ++d) {
+          if (d == axis) continue;
+          centre[d] = c.at("center").at(m++).get<double>();
+          lo[d] = centre[d] - radius;
+          hi[d] = centre[d] + radius;
+        }
+        lo[axis] = c.at("min").get<double>();
+        hi[axis] = c.at("max").get<double>();
+      } else {
+        throw sdk::ParameterError(where + ": expected {\"box\": ...} or {\"cylinder\": ...}");
+      }
+      for (int d = 0; d < 3; ++d)
+        if (!(hi[d] > lo[d])) throw sdk::ParameterError(where + ": max must exceed min along " + std::string(1, "xyz"[d]));
+      std::size_t count = 0;
+      for (int k = 0; k < g.n[2]; ++k)
+        for (int j = 0; j < g.n[1]; ++j)
+          for (int i = 0; i < g.n[0]; ++i) {
+            const int idx[3] = {i, j, k};
+            bool in = true;
+            for (int d = 0; d < 3; ++d) {
+              const double c = g.centre(d, idx[d]);
+              if (hi[d] - lo[d] < g.h[d]) {  // thin along d: the cell's extent overlaps
+                const double clo = g.lo[d] + idx[d] * g.h[d];
+                in = in && clo < hi[d] && clo + g.h[d] > lo[d];
+              } else {
+                in = in && c >= lo[d] && c <= hi[d];
+              }
+            }
+            if (in && axis >= 0) {
+              double r2 = 0;
+              for (int d = 0; d < 3; ++d)
+                if (d != axis) r2 += (g.centre(d, idx[d]) - centre[d]) * (g.centre(d, idx[d]) - centre[d]);
+              in = r2 <= radius * radius;
+            }
+            if (in) {
+              blocked[g.cell(i, j, k)] = 1;
+              ++count;
+            }
+          }
+      if (count == 0)
+        throw sdk::ParameterError(where + ": blocks no cell (it lies outside the grid, or a cylinder's radius misses "
+                                          "every cell centre: use a larger radius or smaller cells)");
+    }
+    return blocked;
+  }
+
+  sdk::Host host_;
+  std::unique_ptr<VansSolver> solver_;
+  PressureCg cg_;
+  DragLaw law_ = DragLaw::di_felice;
+  bool scaling_ = true, pressure_force_ = true, two_way_ = true;
+  double eps_min_ = 0.3, cfl_ = 0.5;
+  int substeps_ = 1;
+  bool gravity_set_ = false;
+  std::uint64_t exchanges_ = 0, iterations_ = 0;
+  SolveReport last_solve_;
+  double vmax_ = 0;
+  bool warned_resolution_ = false, warned_validity_ = false;
+  std::vector<double> velocity_, eps_, p_, K_, blocked_;
+  const double* data_[5] = {nullptr, nullptr, nullptr, nullptr, nullptr};
+};
+
+}  // namespace domel::plugins::fluid

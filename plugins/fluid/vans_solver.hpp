@@ -1,0 +1,457 @@
+// SPDX-License-Identifier: MIT
+// The incompressible volume-averaged Navier-Stokes equations of the built-in
+// fluid coupler, Anderson & Jackson's "model A" (set II of Zhou, Kuang, Chu &
+// Yu 2010, J. Fluid Mech. 661:482; docs/fluid.md says why A and not B):
+//
+//   d(eps)/dt + div(eps u) = 0
+//   rho_f eps (du/dt + (u . grad) u) = -eps grad p + mu div(eps grad u)
+//                                      + rho_f eps g - K (u - u_s)
+//
+// on a uniform staggered grid (mac_grid.hpp); u is the interstitial velocity,
+// eps the fluid volume fraction, K (u - u_s) the drag the particles exert per
+// unit volume (K = sum of the particles' beta over the cell volume, u_s their
+// mean velocity weighted by beta). The momentum equation is written in its
+// advective form, which equals the conservative one where continuity holds.
+// One step of length dt is an incremental pressure-correction projection
+// (Chorin 1968; Spalding's partial elimination for the drag):
+//
+//   predictor   rho_f eps^{n+1} (u* - u^n)/dt = R^n - K (u* - u_s)
+//               with R^n = -rho_f eps (u^n . grad) u^n   (first-order upwind)
+//                          + mu eps lap u^n - eps grad p^n + rho_f eps g,
+//               so u* = (rho_f eps u^n/dt + R^n + K u_s) / (rho_f eps/dt + K)
+//               face by face: the drag is implicit, no limit from K;
+//   correction  u^{n+1} = u* - A grad p',  A = eps dt / (rho_f eps + K dt),
+//   pressure    div(eps A grad p') = div(eps u*) + (eps^{n+1} - eps^n)/dt,
+//               a symmetric positive-definite 7-point system (solved by the
+//               caller's PressureSolver), then p^{n+1} = p^n + p'.
+//
+// Boundaries, per side of the box: no-slip wall (normal velocity 0, the
+// tangential one mirrored), slip wall (normal velocity 0, no shear: a plane
+// of symmetry), velocity inlet over the whole side or a patch of
+// it (the rest of the side is wall), pressure outlet (p fixed half a cell
+// outside the last cell centre, zero gradient of the velocity). Blocked cells
+// (obstacles) are walls on every face. At least one outlet is required: it
+// fixes the pressure level, so the system is non-singular.
+#pragma once
+
+#include "plugins/fluid/mac_grid.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace domel::plugins::fluid {
+
+enum class Side { x_min = 0, x_max, y_min, y_max, z_min, z_max };
+constexpr const char* kSideNames[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+
+struct Boundary {
+  enum Type { wall, slip_wall, velocity_inlet, pressure_outlet } type = wall;
+  std::array<double, 3> velocity{0, 0, 0};  ///< inlet velocity [m/s]
+  bool patch = false;                       ///< inlet over a patch only
+  std::array<double, 3> patch_lo{0, 0, 0}, patch_hi{0, 0, 0};
+  double pressure = 0;                      ///< outlet pressure [Pa]
+};
+
+/// The face's role: free (solved: interior between two fluid cells, or on an
+/// outlet) or fixed (wall, inlet, a face of a blocked cell).
+enum class FaceKind : std::uint8_t { interior, outlet, wall, inlet };
+
+/// Solves A x = b for the pressure correction: A sparse SPD, given row by
+/// row as (diag, neighbours). Returns iterations and relative residual.
+struct PressureSystem {
+  std::vector<double> diag;                           ///< per unknown
+  std::vector<std::vector<std::pair<std::size_t, double>>> off;  ///< per unknown: (column, value), value < 0
+  std::vector<double> rhs;
+  /// |rhs| below which the system counts as solved [1/s]: the round-off of
+  /// a fluid at rest would otherwise be iterated on as if it were flow
+  double reference_norm = 0;
+};
+struct SolveReport {
+  int iterations = 0;
+  double residual = 0;
+};
+using PressureSolver = std::function<SolveReport(const PressureSystem&, std::vector<double>& x)>;
+
+class VansSolver {
+ public:
+  struct Settings {
+    MacGrid grid;
+    std::array<Boundary, 6> sides;
+    double rho = 1.2;   ///< [kg/m^3]
+    double mu = 1.8e-5; ///< [Pa s]
+    std::array<double, 3> gravity{0, 0, 0};
+    std::array<double, 3> initial_velocity{0, 0, 0};
+  };
+
+  VansSolver(Settings s, std::vector<std::uint8_t> blocked) : s_(std::move(s)), blocked_(std::move(blocked)) {
+    const MacGrid& g = s_.grid;
+    if (blocked_.empty()) blocked_.assign(g.cells(), 0);
+    if (blocked_.size() != g.cells()) throw std::invalid_argument("blocked cells do not match the grid");
+    bool outlet = false;
+    for (const auto& b : s_.sides) outlet = outlet || b.type == Boundary::pressure_outlet;
+    if (!outlet) throw std::invalid_argument("no pressure outlet: the pressure has no reference level");
+    eps_.assign(g.cells(), 1.0);
+    eps_old_ = eps_;
+    p_.assign(g.cells(), 0.0);
+    for (int a = 0; a < 3; ++a) {
+      kind_[a].assign(g.faces(a), FaceKind::interior);
+      u_[a].assign(g.faces(a), 0.0);
+      K_[a].assign(g.faces(a), 0.0);
+      Ku_[a].assign(g.faces(a), 0.0);
+    }
+    classify_faces();
+    // unknowns: the fluid cells
+    unknown_.assign(g.cells(), SIZE_MAX);
+    for (std::size_t c = 0; c < g.cells(); ++c)
+      if (!blocked_[c]) unknown_[c] = n_unknowns_++;
+    // start: the initial velocity on the free faces, the inlet values on inlets;
+    // the pressure hydrostatic from the first outlet
+    for (int a = 0; a < 3; ++a)
+      for (std::size_t f = 0; f < g.faces(a); ++f)
+        u_[a][f] = kind_[a][f] == FaceKind::inlet ? inlet_value_[a][f]
+                   : (kind_[a][f] == FaceKind::wall ? 0.0 : s_.initial_velocity[a]);
+    for (int side = 0; side < 6; ++side)
+      if (s_.sides[side].type == Boundary::pressure_outlet) {
+        const int a = side / 2;
+        double ref[3];
+        for (int d = 0; d < 3; ++d) ref[d] = 0.5 * (g.lo[d] + g.hi(d));
+        ref[a] = side % 2 ? g.hi(a) : g.lo[a];
+        for (int k = 0; k < g.n[2]; ++k)
+          for (int j = 0; j < g.n[1]; ++j)
+            for (int i = 0; i < g.n[0]; ++i) {
+              const double x[3] = {g.centre(0, i), g.centre(1, j), g.centre(2, k)};
+              double p = s_.sides[side].pressure;
+              for (int d = 0; d < 3; ++d) p += s_.rho * s_.gravity[d] * (x[d] - ref[d]);
+              p_[g.cell(i, j, k)] = p;
+            }
+        break;
+      }
+  }
+
+  const Settings& settings() const { return s_; }
+  const MacGrid& grid() const { return s_.grid; }
+  const std::vector<double>& eps() const { return eps_; }
+  const std::vector<double>& pressure() const { return p_; }
+  const std::vector<double>& u(int a) const { return u_[a]; }
+  const std::vector<double>& K(int a) const { return K_[a]; }
+  const std::vector<FaceKind>& kind(int a) const { return kind_[a]; }
+  const std::vector<std::uint8_t>& blocked() const { return blocked_; }
+  std::vector<double>& eps_mut() { return eps_; }
+  std::vector<double>& K_mut(int a) { return K_[a]; }
+  std::vector<double>& Ku_mut(int a) { return Ku_[a]; }
+  std::vector<double>& u_mut(int a) { return u_[a]; }
+
+  /// Remember the current void fraction as eps^n before a new deposit.
+  void keep_old_void_fraction() { eps_old_ = eps_; }
+
+  /// Largest |u_a| over the free and inlet faces, per axis.
+  std::array<double, 3> max_speed() const {
+    std::array<double, 3> m{0, 0, 0};
+    for (int a = 0; a < 3; ++a)
+      for (double v : u_[a]) m[a] = std::max(m[a], std::abs(v));
+    return m;
+  }
+
+  /// One projection step of length dt. `frac` in (0, 1]: where the void
+  /// fraction stands within the interval (eps^n + frac (eps^{n+1} - eps^n)),
+  /// for sub-steps; eps_old_ is eps at the start of the interval.
+  SolveReport step(double dt, double frac_from, double frac_to, const PressureSolver& solve) {
+    const MacGrid& g = s_.grid;
+    std::vector<double> e0(g.cells()), e1(g.cells());
+    for (std::size_t c = 0; c < g.cells(); ++c) {
+      e0[c] = eps_old_[c] + frac_from * (eps_[c] - eps_old_[c]);
+      e1[c] = eps_old_[c] + frac_to * (eps_[c] - eps_old_[c]);
+    }
+    // predictor
+    std::array<std::vector<double>, 3> us, A;
+    for (int a = 0; a < 3; ++a) {
+      us[a] = u_[a];
+      A[a].assign(g.faces(a), 0.0);
+    }
+    for (int a = 0; a < 3; ++a)
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        const FaceKind kd = kind_[a][f];
+        if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
+        const double ef1 = face_eps(e1, a, i, j, k), ef0 = face_eps(e0, a, i, j, k);
+        const double un = u_[a][f];
+        // advection (first-order upwind) and diffusion of u_a
+        double adv = 0, lap = 0;
+        for (int b = 0; b < 3; ++b) {
+          const double ub = (b == a) ? un : cross_velocity(a, b, i, j, k);
+          const double um = neighbour(a, b, -1, i, j, k), up = neighbour(a, b, +1, i, j, k);
+          adv += ub > 0 ? ub * (un - um) / g.h[b] : ub * (up - un) / g.h[b];
+          lap += (up - 2 * un + um) / (g.h[b] * g.h[b]);
+        }
+        const double gradp = face_gradient(p_, a, i, j, k, kd);
+        const double R = -s_.rho * ef1 * adv + s_.mu * ef1 * lap - ef1 * gradp + s_.rho * ef1 * s_.gravity[a];
+        (void)ef0;
+        const double K = K_[a][f];
+        us[a][f] = (s_.rho * ef1 * un / dt + R + Ku_[a][f]) / (s_.rho * ef1 / dt + K);
+        A[a][f] = ef1 * dt / (s_.rho * ef1 + K * dt);
+      });
+    // pressure system
+    PressureSystem sys;
+    sys.diag.assign(n_unknowns_, 0.0);
+    sys.off.assign(n_unknowns_, {});
+    sys.rhs.assign(n_unknowns_, 0.0);
+    for (int k = 0; k < g.n[2]; ++k)
+      for (int j = 0; j < g.n[1]; ++j)
+        for (int i = 0; i < g.n[0]; ++i) {
+          const std::size_t c = g.cell(i, j, k);
+          if (blocked_[c]) continue;
+          const std::size_t P = unknown_[c];
+          double div = 0;
+          const int idx[3] = {i, j, k};
+          for (int a = 0; a < 3; ++a) {
+            for (int s = 0; s < 2; ++s) {  // s = 0: the face on the low side, 1: the high side
+              int fi[3] = {i, j, k};
+              fi[a] += s;
+              const std::size_t f = g.face(a, fi[0], fi[1], fi[2]);
+              const double ef = face_eps(e1, a, fi[0], fi[1], fi[2]);
+              div += (s ? 1.0 : -1.0) * ef * us[a][f] / g.h[a];
+              const FaceKind kd = kind_[a][f];
+              if (kd == FaceKind::interior) {
+                int ni[3] = {i, j, k};
+                ni[a] += s ? 1 : -1;
+                const double coef = ef * A[a][f] / (g.h[a] * g.h[a]);
+                sys.diag[P] += coef;
+                sys.off[P].push_back({unknown_[g.cell(ni[0], ni[1], ni[2])], -coef});
+              } else if (kd == FaceKind::outlet) {
+                sys.diag[P] += ef * A[a][f] / (g.h[a] * 0.5 * g.h[a]);
+              }
+            }
+            (void)idx;
+          }
+          sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
+        }
+    {
+      // the divergence a velocity error of 1e-6 of the flow's scale (or of
+      // 1 mm/s at rest) would give, over the whole system
+      const auto um = max_speed();
+      double rate = 0, hmin = g.h[0];
+      for (int a = 0; a < 3; ++a) {
+        rate += um[a] / g.h[a];
+        hmin = std::min(hmin, g.h[a]);
+      }
+      sys.reference_norm = std::sqrt(static_cast<double>(n_unknowns_)) * (rate + 1e-3 / hmin);
+    }
+    std::vector<double> pc(n_unknowns_, 0.0);
+    const SolveReport rep = solve(sys, pc);
+    // correction
+    auto pcorr = [&](int i, int j, int k) { return pc[unknown_[g.cell(i, j, k)]]; };
+    for (int a = 0; a < 3; ++a)
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        const FaceKind kd = kind_[a][f];
+        if (kd == FaceKind::interior) {
+          int l[3] = {i, j, k};
+          l[a] -= 1;
+          u_[a][f] = us[a][f] - A[a][f] * (pcorr(i, j, k) - pcorr(l[0], l[1], l[2])) / g.h[a];
+        } else if (kd == FaceKind::outlet) {
+          const int idx[3] = {i, j, k};
+          if (idx[a] == 0)  // low side: the cell is (i, j, k); p' = 0 outside
+            u_[a][f] = us[a][f] - A[a][f] * (pcorr(i, j, k) - 0.0) / (0.5 * g.h[a]);
+          else {
+            int l[3] = {i, j, k};
+            l[a] -= 1;
+            u_[a][f] = us[a][f] - A[a][f] * (0.0 - pcorr(l[0], l[1], l[2])) / (0.5 * g.h[a]);
+          }
+        }
+      });
+    for (std::size_t c = 0; c < g.cells(); ++c)
+      if (!blocked_[c]) p_[c] += pc[unknown_[c]];
+    return rep;
+  }
+
+  /// Gradient of the pressure on the face grid of axis a (for the particles'
+  /// pressure-gradient force): the face difference where the face is free,
+  /// the nearest free face's along a where it is fixed (a wall has the
+  /// gradient of the fluid beside it, e.g. the hydrostatic one).
+  std::vector<double> pressure_gradient(int a) const {
+    const MacGrid& g = s_.grid;
+    std::vector<double> G(g.faces(a), 0.0);
+    for_faces(a, [&](int i, int j, int k, std::size_t f) {
+      const FaceKind kd = kind_[a][f];
+      if (kd == FaceKind::interior || kd == FaceKind::outlet) G[f] = face_gradient(p_, a, i, j, k, kd);
+    });
+    // fixed faces: copy inward along a
+    for_faces(a, [&](int i, int j, int k, std::size_t f) {
+      const FaceKind kd = kind_[a][f];
+      if (kd == FaceKind::interior || kd == FaceKind::outlet) return;
+      int idx[3] = {i, j, k};
+      for (int step : {+1, -1}) {
+        int q[3] = {idx[0], idx[1], idx[2]};
+        q[a] += step;
+        if (q[a] < 0 || q[a] > g.n[a]) continue;
+        const std::size_t fq = g.face(a, q[0], q[1], q[2]);
+        if (kind_[a][fq] == FaceKind::interior || kind_[a][fq] == FaceKind::outlet) {
+          G[f] = face_gradient(p_, a, q[0], q[1], q[2], kind_[a][fq]);
+          return;
+        }
+      }
+    });
+    return G;
+  }
+
+  /// Cell-centred velocity (mean of the two faces along each axis).
+  void cell_velocity(std::vector<double>& out) const {
+    const MacGrid& g = s_.grid;
+    out.assign(3 * g.cells(), 0.0);
+    for (int k = 0; k < g.n[2]; ++k)
+      for (int j = 0; j < g.n[1]; ++j)
+        for (int i = 0; i < g.n[0]; ++i) {
+          const std::size_t c = g.cell(i, j, k);
+          for (int a = 0; a < 3; ++a) {
+            int hi[3] = {i, j, k};
+            hi[a] += 1;
+            out[3 * c + a] = 0.5 * (u_[a][g.face(a, i, j, k)] + u_[a][g.face(a, hi[0], hi[1], hi[2])]);
+          }
+        }
+  }
+
+  /// div(eps u) + d(eps)/dt of the last step's end state, per fluid cell
+  /// (the residual continuity leaves after the projection), as the largest
+  /// |value| times the cell's time scale dt: a dimensionless check.
+  double continuity_residual(double dt) const {
+    const MacGrid& g = s_.grid;
+    double worst = 0;
+    for (int k = 0; k < g.n[2]; ++k)
+      for (int j = 0; j < g.n[1]; ++j)
+        for (int i = 0; i < g.n[0]; ++i) {
+          const std::size_t c = g.cell(i, j, k);
+          if (blocked_[c]) continue;
+          double div = (eps_[c] - eps_old_[c]) / dt;
+          for (int a = 0; a < 3; ++a)
+            for (int s = 0; s < 2; ++s) {
+              int fi[3] = {i, j, k};
+              fi[a] += s;
+              div += (s ? 1.0 : -1.0) * face_eps(eps_, a, fi[0], fi[1], fi[2]) * u_[a][g.face(a, fi[0], fi[1], fi[2])] / g.h[a];
+            }
+          worst = std::max(worst, std::abs(div) * dt);
+        }
+    return worst;
+  }
+
+  template <class F>
+  void for_faces(int a, F&& fn) const {
+    const MacGrid& g = s_.grid;
+    for (int k = 0; k < g.fn(a, 2); ++k)
+      for (int j = 0; j < g.fn(a, 1); ++j)
+        for (int i = 0; i < g.fn(a, 0); ++i) fn(i, j, k, g.face(a, i, j, k));
+  }
+
+  /// Void fraction on face (i, j, k) of axis a: the mean of the cells on its
+  /// two sides, the inner cell's on the boundary.
+  double face_eps(const std::vector<double>& e, int a, int i, int j, int k) const {
+    const MacGrid& g = s_.grid;
+    const int idx[3] = {i, j, k};
+    int l[3] = {i, j, k};
+    l[a] -= 1;
+    if (idx[a] == 0) return e[g.cell(i, j, k)];
+    if (idx[a] == g.n[a]) return e[g.cell(l[0], l[1], l[2])];
+    return 0.5 * (e[g.cell(i, j, k)] + e[g.cell(l[0], l[1], l[2])]);
+  }
+
+ private:
+  void classify_faces() {
+    const MacGrid& g = s_.grid;
+    for (int a = 0; a < 3; ++a) inlet_value_[a].assign(g.faces(a), 0.0);
+    for (int a = 0; a < 3; ++a)
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        const int idx[3] = {i, j, k};
+        if (idx[a] == 0 || idx[a] == g.n[a]) {
+          const int side = 2 * a + (idx[a] == 0 ? 0 : 1);
+          const Boundary& b = s_.sides[side];
+          int in[3] = {i, j, k};
+          if (idx[a] == g.n[a]) in[a] -= 1;
+          const bool inner_blocked = blocked_[g.cell(in[0], in[1], in[2])] != 0;
+          if (inner_blocked || b.type == Boundary::wall || b.type == Boundary::slip_wall) {
+            kind_[a][f] = FaceKind::wall;
+          } else if (b.type == Boundary::pressure_outlet) {
+            kind_[a][f] = FaceKind::outlet;
+          } else {
+            bool inside = true;
+            if (b.patch)
+              for (int d = 0; d < 3; ++d) {
+                if (d == a) continue;
+                const double x = g.centre(d, idx[d]);
+                inside = inside && x >= b.patch_lo[d] && x <= b.patch_hi[d];
+              }
+            kind_[a][f] = inside ? FaceKind::inlet : FaceKind::wall;
+            if (inside) inlet_value_[a][f] = b.velocity[a];
+          }
+          return;
+        }
+        int l[3] = {i, j, k};
+        l[a] -= 1;
+        if (blocked_[g.cell(i, j, k)] || blocked_[g.cell(l[0], l[1], l[2])]) kind_[a][f] = FaceKind::wall;
+      });
+  }
+
+  /// p gradient along a at a free face.
+  double face_gradient(const std::vector<double>& p, int a, int i, int j, int k, FaceKind kd) const {
+    const MacGrid& g = s_.grid;
+    const int idx[3] = {i, j, k};
+    int l[3] = {i, j, k};
+    l[a] -= 1;
+    if (kd == FaceKind::outlet) {
+      const int side = 2 * a + (idx[a] == 0 ? 0 : 1);
+      const double pb = s_.sides[side].pressure;
+      if (idx[a] == 0) return (p[g.cell(i, j, k)] - pb) / (0.5 * g.h[a]);
+      return (pb - p[g.cell(l[0], l[1], l[2])]) / (0.5 * g.h[a]);
+    }
+    return (p[g.cell(i, j, k)] - p[g.cell(l[0], l[1], l[2])]) / g.h[a];
+  }
+
+  /// The velocity component b at face (i, j, k) of axis a (b != a): the mean
+  /// of the (up to) four b-faces around it.
+  double cross_velocity(int a, int b, int i, int j, int k) const {
+    const MacGrid& g = s_.grid;
+    double sum = 0;
+    int cnt = 0;
+    for (int da = -1; da <= 0; ++da)
+      for (int db = 0; db <= 1; ++db) {
+        int q[3] = {i, j, k};
+        q[a] += da;
+        q[b] += db;
+        if (q[a] < 0 || q[a] >= g.fn(b, a)) continue;
+        sum += u_[b][g.face(b, q[0], q[1], q[2])];
+        ++cnt;
+      }
+    return cnt ? sum / cnt : 0.0;
+  }
+
+  /// u_a at the face one step along b (dir -1 or +1) from face (i, j, k) of
+  /// axis a, with the boundary's ghost value beyond the box: a wall mirrors
+  /// the tangential velocity (no slip), an inlet sets it, an outlet copies it.
+  double neighbour(int a, int b, int dir, int i, int j, int k) const {
+    const MacGrid& g = s_.grid;
+    int q[3] = {i, j, k};
+    q[b] += dir;
+    const double here = u_[a][g.face(a, i, j, k)];
+    if (q[b] >= 0 && q[b] < g.fn(a, b)) return u_[a][g.face(a, q[0], q[1], q[2])];
+    if (b == a) return here;  // beyond the last normal face: zero gradient
+    const Boundary& bd = s_.sides[2 * b + (dir > 0 ? 1 : 0)];
+    switch (bd.type) {
+      case Boundary::wall: return -here;
+      case Boundary::slip_wall: return here;
+      case Boundary::velocity_inlet: return 2 * bd.velocity[a] - here;
+      default: return here;
+    }
+  }
+
+  Settings s_;
+  std::vector<std::uint8_t> blocked_;
+  std::vector<double> eps_, eps_old_, p_;
+  std::array<std::vector<double>, 3> u_, K_, Ku_, inlet_value_;
+  std::array<std::vector<FaceKind>, 3> kind_;
+  std::vector<std::size_t> unknown_;
+  std::size_t n_unknowns_ = 0;
+};
+
+}  // namespace domel::plugins::fluid

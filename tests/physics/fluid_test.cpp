@@ -1,0 +1,203 @@
+// SPDX-License-Identifier: MIT
+// Guards the built-in fluid coupler "vans" (plugins/fluid/vans.hpp; issue 16
+// item 4, docs/validation/fluid.md) at CI size:
+//  (a) one sphere settling in quiescent air, one way: its terminal velocity
+//      against Schiller & Naumann's at particle Reynolds numbers 0.1, 3.7
+//      and 456, within 2 % (the issue's tolerance; the discrete scheme's own
+//      error is far smaller: the fluid stays at rest and the refreshed drag's
+//      fixed point is exact), and a parcel of alpha = 2 at the original
+//      sphere's velocity with coarse-grain drag scaling, at alpha^2 the Stokes
+//      velocity's share without;
+//  (b) air through a fixed bed (a simple cubic lattice of 1 mm spheres,
+//      eps = 1 - pi/6 inside, between slip walls): the pressure gradient in
+//      the bed against each drag law's own homogeneous-bed value with the
+//      bed's void fraction as the coupler measured it, at Re_p = 1, 20 and
+//      100, within 5 % (the issue's tolerance); with the Gidaspow law that
+//      value is Ergun's (1952) pressure drop.
+#include "plugins/fluid/drag_laws.hpp"
+#include "support/fixture.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace dt = domel::test;
+namespace dp = domel::platform;
+namespace fl = domel::plugins::fluid;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kRhoP = 2500, kRhoF = 1.2, kMu = 1.8e-5, kG = 9.81;
+
+std::filesystem::path out_dir(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("domel_fluid_" + name + "_" + std::to_string(getpid()));
+}
+
+dp::RunResult run(dp::Simulation& sim, const std::string& name) {
+  dp::RunOptions o;
+  o.output_directory = out_dir(name);
+  o.progress = false;
+  std::filesystem::remove_all(o.output_directory);
+  dp::RunResult r = sim.run(o, dt::builtin_registry());
+  std::filesystem::remove_all(o.output_directory);
+  return r;
+}
+
+/// One sphere of diameter d (a parcel of alpha d at ratio alpha) released at
+/// rest near the top of a tall column of quiescent air, one-way coupled.
+json settling(double d, double alpha, bool scaling, double duration, double dt_dem, double height) {
+  // a lone sphere never touches anything: a soft material lets the time step
+  // follow the drag's relaxation time instead of a contact that never happens
+  json doc = dt::scenario(dt::hertz_mindlin(), dt_dem, 0.5, 0.5, 1.0, 0.3, kRhoP);
+  doc["gravity"] = {0, 0, -kG};
+  doc["subdomains"][0]["coarse_grain"] = alpha;
+  const double top = 0.95 * height;
+  json box = {{"min", {0.45, 0.45, top - 0.1}}, {"max", {0.55, 0.55, top}}};
+  json insert = {{"model", "lattice"}, {"diameter", d}, {"count", 1}, {"region", {{"box", box}}}};
+  doc["subdomains"][0]["insert"] = json::array({insert});
+  doc["fluid"] = {{"model", "vans"},
+                  {"interval", 10 * dt_dem},
+                  {"grid", {{"min", {0, 0, 0}}, {"max", {1.0, 1.0, height}}, {"cells", {2, 2, 10}}}},
+                  {"density", kRhoF},
+                  {"viscosity", kMu},
+                  {"boundaries", {{"z_max", {{"type", "pressure_outlet"}}}}},
+                  {"drag", {{"law", "schiller_naumann"}, {"coarse_grain_scaling", scaling}}},
+                  {"coupling", "one_way"}};
+  doc["run"] = {{"duration", duration}};
+  return doc;
+}
+
+double final_vz(const json& doc, const std::string& name) {
+  auto sim = dt::build(doc);
+  run(*sim, name);
+  return sim->subdomains[0]->store().vz[0];
+}
+
+}  // namespace
+
+// (a) Re_p = 0.1 (d = 27 um), 3.7 (100 um) and 456 (1 mm). Each runs about
+// 8 of its relaxation times m/beta (what is left of the start: e^-8 = 3e-4).
+TEST(FluidVans, TerminalVelocityOfOneSphereMatchesSchillerNaumann) {
+  struct Case {
+    double d, duration, dt, height;
+  } cases[] = {{27e-6, 0.05, 1e-4, 1.0}, {100e-6, 0.6, 1e-4, 1.0}, {1e-3, 4.0, 1e-3, 40.0}};
+  for (const auto& c : cases) {
+    const double vt = fl::schiller_naumann_terminal_velocity(c.d, kRhoP, kRhoF, kMu, kG);
+    const double re = kRhoF * vt * c.d / kMu;
+    const double v = -final_vz(settling(c.d, 1, true, c.duration, c.dt, c.height), "settle");
+    std::printf("[terminal velocity] d = %g m: Re = %.3g, v = %.6g m/s, Schiller-Naumann %.6g m/s (%+.2e)\n", c.d,
+                re, v, vt, v / vt - 1);
+    EXPECT_NEAR(v, vt, 0.02 * vt) << "d = " << c.d;
+  }
+}
+
+// A parcel of alpha = 2 in the Stokes regime (d = 27 um): with scaling it
+// falls as the original sphere; without, it feels the drag of one sphere of
+// its own diameter and falls faster, alpha^2 = 4 times in the Stokes limit
+// (a little less at its Re of 0.8).
+TEST(FluidVans, CoarseGrainDragScalingKeepsTheTerminalVelocity) {
+  const double d = 27e-6;
+  const double vt = fl::schiller_naumann_terminal_velocity(d, kRhoP, kRhoF, kMu, kG);
+  const double scaled = -final_vz(settling(d, 2, true, 0.05, 1e-4, 1.0), "cg_scaled");
+  const double plain = -final_vz(settling(d, 2, false, 0.2, 1e-4, 1.0), "cg_plain");
+  const double vt_parcel = fl::schiller_naumann_terminal_velocity(2 * d, kRhoP, kRhoF, kMu, kG);
+  std::printf("[coarse grain] alpha 2: scaled %.6g m/s, unscaled %.6g m/s; original %.6g, a %g m sphere %.6g\n",
+              scaled, plain, vt, 2 * d, vt_parcel);
+  EXPECT_NEAR(scaled, vt, 0.02 * vt);
+  EXPECT_NEAR(plain, vt_parcel, 0.02 * vt_parcel);
+  EXPECT_GT(plain, 3 * vt);
+}
+
+namespace {
+
+struct BedResult {
+  double gradient;  ///< -dp/dz in the bed [Pa/m]
+  double eps;       ///< the bed's mean void fraction as the coupler deposited it
+};
+
+/// Air rising at superficial velocity us through a bed of fixed 1 mm spheres
+/// on a simple cubic lattice filling [0, 0.005]^2 x [0.02, 0.07] m, in a
+/// column of 1 x 1 x 20 cells of 5 mm whose slip walls make it a slice of an
+/// unbounded bed; after 0.05 s (the flow's relaxation time rho_f eps / K is
+/// below 1e-3 s even at Re_p = 1); measured at the end
+/// from the coupler's fields: the slope of the centre-line pressure over the
+/// bed's inner cells (one cell kept clear of each end of the bed).
+BedResult fixed_bed(const std::string& law, double us) {
+  const double d = 1e-3;
+  json doc = dt::scenario(dt::hertz_mindlin(), 1e-4, 0.5, 0.5, 1e6, 0.3, kRhoP);
+  doc["gravity"] = {0, 0, -kG};
+  json box = {{"min", {0, 0, 0.02}}, {"max", {0.005, 0.005, 0.07}}};
+  json insert = {{"model", "lattice"}, {"diameter", d}, {"spacing", 1.0}, {"fixed", true}, {"region", {{"box", box}}}};
+  doc["subdomains"][0]["insert"] = json::array({insert});
+  json slip = {{"type", "slip_wall"}};
+  doc["fluid"] = {{"model", "vans"},
+                  {"interval", 1e-4},
+                  {"grid", {{"min", {0, 0, 0}}, {"max", {0.005, 0.005, 0.1}}, {"cells", {1, 1, 20}}}},
+                  {"density", kRhoF},
+                  {"viscosity", kMu},
+                  {"boundaries",
+                   {{"x_min", slip}, {"x_max", slip}, {"y_min", slip}, {"y_max", slip},
+                    {"z_min", {{"type", "velocity_inlet"}, {"velocity", {0, 0, us}}}},
+                    {"z_max", {{"type", "pressure_outlet"}}}}},
+                  {"drag", {{"law", law}}},
+                  {"initial_velocity", {0, 0, us}},
+                  {"write_interval", 0}};
+  doc["run"] = {{"duration", 0.05}};
+  auto sim = dt::build(doc);
+  run(*sim, "bed");
+  domel_fluid_fields_v1 f{};
+  EXPECT_TRUE(sim->fluid->spec().model->fluid_fields(f));
+  const double* p = nullptr;
+  const double* e = nullptr;
+  for (uint32_t k = 0; k < f.field_count; ++k) {
+    if (std::string(f.names[k]) == "pressure") p = f.data[k];
+    if (std::string(f.names[k]) == "void_fraction") e = f.data[k];
+  }
+  // cells 5..12 along z (z = 0.025 .. 0.065): the bed's inside, one cell from each end
+  double sz = 0, sp = 0, szz = 0, szp = 0, se = 0;
+  int n = 0;
+  for (int k = 5; k <= 12; ++k) {
+    const double z = (k + 0.5) * 0.005;
+    const std::size_t c = static_cast<std::size_t>(k);  // cell (0, 0, k)
+    sz += z, sp += p[c], szz += z * z, szp += z * p[c], se += e[c];
+    ++n;
+  }
+  const double slope = (n * szp - sz * sp) / (n * szz - sz * sz);
+  // the hydrostatic part of p is rho_f g per metre; the bed's drag is the rest
+  return {-(slope + kRhoF * kG), se / n};
+}
+
+/// A homogeneous bed's pressure gradient under model A: eps dp/dz = -n F,
+/// with n = (1 - eps)/V_p spheres per volume and the interstitial slip us/eps.
+double law_gradient(fl::DragLaw law, double us, double eps, double d) {
+  const double vp = M_PI * d * d * d / 6;
+  const double u = us / eps;
+  return (1 - eps) / vp * fl::beta(law, d, eps, u, kRhoF, kMu) * u / eps;
+}
+
+}  // namespace
+
+// (b) Re_p = rho_f us d / mu = 1, 20 and 100.
+TEST(FluidVans, FixedBedPressureGradientFollowsTheDragLaw) {
+  const double d = 1e-3;
+  for (const char* law : {"gidaspow", "di_felice", "beetstra"}) {
+    for (double re : {1.0, 20.0, 100.0}) {
+      const double us = re * kMu / (kRhoF * d);
+      const BedResult r = fixed_bed(law, us);
+      const double expected = law_gradient(*fl::drag_law_from_name(law), us, r.eps, d);
+      std::printf("[fixed bed] %s Re_p %g: eps %.4f, -dp/dz %.5g Pa/m, the law's %.5g (%+.2e)", law, re, r.eps,
+                  r.gradient, expected, r.gradient / expected - 1);
+      if (std::string(law) == "gidaspow")
+        std::printf(", Ergun %.5g", fl::ergun_pressure_gradient(us, r.eps, d, kRhoF, kMu));
+      std::printf("\n");
+      EXPECT_NEAR(r.gradient, expected, 0.05 * expected) << law << " at Re_p " << re;
+      EXPECT_NEAR(r.eps, 1 - M_PI / 6, 0.01) << "the lattice's void fraction";
+    }
+  }
+}
