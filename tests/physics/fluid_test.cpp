@@ -12,8 +12,8 @@
 //      eps = 1 - pi/6 inside, between slip walls): the pressure gradient in
 //      the bed against each drag law's own homogeneous-bed value with the
 //      bed's void fraction as the coupler measured it, at Re_p = 1, 20 and
-//      100, within 5 % (the issue's tolerance); with the Gidaspow law that
-//      value is Ergun's (1952) pressure drop.
+//      100, to the pressure solve's tolerance (the issue asks 5 %); with the
+//      Gidaspow law that value is Ergun's (1952) pressure drop.
 #include "plugins/fluid/drag_laws.hpp"
 #include "support/fixture.hpp"
 
@@ -126,8 +126,8 @@ struct BedResult {
 /// column of 1 x 1 x 20 cells of 5 mm whose slip walls make it a slice of an
 /// unbounded bed; after 0.05 s (the flow's relaxation time rho_f eps / K is
 /// below 1e-3 s even at Re_p = 1); measured at the end
-/// from the coupler's fields: the slope of the centre-line pressure over the
-/// bed's inner cells (one cell kept clear of each end of the bed).
+/// from the coupler's fields: the slope of the pressure over the bed's inner
+/// cells (two cells kept clear of each end of the bed).
 BedResult fixed_bed(const std::string& law, double us) {
   const double d = 1e-3;
   json doc = dt::scenario(dt::hertz_mindlin(), 1e-4, 0.5, 0.5, 1e6, 0.3, kRhoP);
@@ -159,10 +159,14 @@ BedResult fixed_bed(const std::string& law, double us) {
     if (std::string(f.names[k]) == "pressure") p = f.data[k];
     if (std::string(f.names[k]) == "void_fraction") e = f.data[k];
   }
-  // cells 5..12 along z (z = 0.025 .. 0.065): the bed's inside, one cell from each end
+  // cells 6..11 along z (z = 0.03 .. 0.06): the bed's inside. The bed fills
+  // cells 4..13; the trilinear kernel reaches a cell and a half, so a
+  // particle in the outer half of cell 5 sees some of cell 4's looser
+  // packing, and its smaller beta lowers K on the face between cells 5 and
+  // 6: the faces of uniform K are those between cells 6 and 11.
   double sz = 0, sp = 0, szz = 0, szp = 0, se = 0;
   int n = 0;
-  for (int k = 5; k <= 12; ++k) {
+  for (int k = 6; k <= 11; ++k) {
     const double z = (k + 0.5) * 0.005;
     const std::size_t c = static_cast<std::size_t>(k);  // cell (0, 0, k)
     sz += z, sp += p[c], szz += z * z, szp += z * p[c], se += e[c];
@@ -196,7 +200,10 @@ TEST(FluidVans, FixedBedPressureGradientFollowsTheDragLaw) {
       if (std::string(law) == "gidaspow")
         std::printf(", Ergun %.5g", fl::ergun_pressure_gradient(us, r.eps, d, kRhoF, kMu));
       std::printf("\n");
-      EXPECT_NEAR(r.gradient, expected, 0.05 * expected) << law << " at Re_p " << re;
+      // inside a uniform bed the discrete balance is the law's own: only the
+      // pressure solve's tolerance (1e-8 relative) separates them, so 1e-6
+      // guards it; the issue's 5 % is the scatter of Ergun against random beds
+      EXPECT_NEAR(r.gradient, expected, 1e-6 * expected) << law << " at Re_p " << re;
       EXPECT_NEAR(r.eps, 1 - M_PI / 6, 0.01) << "the lattice's void fraction";
     }
   }
