@@ -60,7 +60,7 @@ class Vans {
       "required": ["min", "max", "cells"], "additionalProperties": false },
     "density": { "type": "number", "exclusiveMinimum": 0, "x-unit": "kg/m^3", "description": "fluid density rho_f (air: 1.2)" },
     "viscosity": { "type": "number", "exclusiveMinimum": 0, "x-unit": "Pa s", "description": "dynamic viscosity mu (air: 1.8e-5)" },
-    "boundaries": { "type": "object", "default": {}, "description": "each side of the box: {\"type\": \"wall\"} (no slip, the default), {\"type\": \"slip_wall\"} (no shear: a plane of symmetry), {\"type\": \"velocity_inlet\", \"velocity\": [..], \"patch\": {\"min\": [..], \"max\": [..]}} (the patch optional: the whole side), or {\"type\": \"pressure_outlet\", \"pressure\": p}; at least one outlet",
+    "boundaries": { "type": "object", "default": {}, "description": "each side of the box: {\"type\": \"wall\"} (no slip, the default), {\"type\": \"slip_wall\"} (no shear: a plane of symmetry), {\"type\": \"velocity_inlet\", \"velocity\": [..], \"patch\": {\"min\": [..], \"max\": [..]}} (the velocity is superficial: eps u across the face; the patch optional: the whole side), or {\"type\": \"pressure_outlet\", \"pressure\": p}; at least one outlet",
       "properties": {
         "x_min": { "$ref": "#/$defs/side" }, "x_max": { "$ref": "#/$defs/side" },
         "y_min": { "$ref": "#/$defs/side" }, "y_max": { "$ref": "#/$defs/side" },

@@ -28,7 +28,8 @@
 // Boundaries, per side of the box: no-slip wall (normal velocity 0, the
 // tangential one mirrored), slip wall (normal velocity 0, no shear: a plane
 // of symmetry), velocity inlet over the whole side or a patch of
-// it (the rest of the side is wall), pressure outlet (p fixed half a cell
+// it (the rest of the side is wall; the velocity given is superficial, so
+// eps u = U across the face even where particles sit on it), pressure outlet (p fixed half a cell
 // outside the last cell centre, zero gradient of the velocity). Blocked cells
 // (obstacles) are walls on every face. At least one outlet is required: it
 // fixes the pressure level, so the system is non-singular.
@@ -168,6 +169,12 @@ class VansSolver {
       e0[c] = eps_old_[c] + frac_from * (eps_[c] - eps_old_[c]);
       e1[c] = eps_old_[c] + frac_to * (eps_[c] - eps_old_[c]);
     }
+    // an inlet prescribes the superficial velocity: eps u = U across the face
+    // (the gas enters from below a bed as through a distributor)
+    for (int a = 0; a < 3; ++a)
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        if (kind_[a][f] == FaceKind::inlet) u_[a][f] = inlet_value_[a][f] / face_eps(e1, a, i, j, k);
+      });
     // predictor
     std::array<std::vector<double>, 3> us, A;
     for (int a = 0; a < 3; ++a) {
