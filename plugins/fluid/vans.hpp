@@ -24,6 +24,9 @@
 #include "plugins/fluid/drag_laws.hpp"
 #include "plugins/fluid/mac_grid.hpp"
 #include "plugins/fluid/pressure_cg.hpp"
+#ifdef DOMEL_HAVE_HYPRE
+#include "plugins/fluid/pressure_pfmg.hpp"
+#endif
 #include "plugins/fluid/vans_solver.hpp"
 
 #include <domel/sdk/plugin.hpp>
@@ -79,6 +82,7 @@ class Vans {
     "cfl": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5, "x-unit": "1", "description": "advective Courant number limit of a fluid step, sum_a |u_a| dt / dx_a (first-order upwind)" },
     "initial_velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "fluid velocity at the start" },
     "solver": { "type": "object", "default": {}, "properties": {
+        "backend": { "enum": ["auto", "cg", "pfmg"], "default": "auto", "description": "pressure solve: cg = Eigen's conjugate gradient with incomplete Cholesky (cost per cell grows with the grid); pfmg = hypre's structured multigrid (PFMG-preconditioned CG; cost per cell about constant; needs a domel built with Debian's libhypre-dev); auto = pfmg when available, else cg" },
         "tolerance": { "type": "number", "exclusiveMinimum": 0, "default": 1e-8, "x-unit": "1", "description": "relative residual of the pressure solve" },
         "max_iterations": { "type": "integer", "minimum": 1, "default": 2000, "description": "iterations of the pressure solve" } },
       "additionalProperties": false }
@@ -98,7 +102,7 @@ class Vans {
   }
 })json";
 
-  explicit Vans(const sdk::Params& p) : host_(p.host()), cg_(1e-8, 2000) {
+  explicit Vans(const sdk::Params& p) : host_(p.host()) {
     const nlohmann::json& j = p.json();
     VansSolver::Settings s;
     const auto& g = j.at("grid");
@@ -159,7 +163,26 @@ class Vans {
     substeps_ = j.value("substeps", 1);
     cfl_ = j.value("cfl", 0.5);
     const nlohmann::json solver = j.value("solver", nlohmann::json::object());
-    cg_ = PressureCg(solver.value("tolerance", 1e-8), solver.value("max_iterations", 2000));
+    const double tol = solver.value("tolerance", 1e-8);
+    const int max_it = solver.value("max_iterations", 2000);
+    std::string backend = solver.value("backend", std::string("auto"));
+#ifdef DOMEL_HAVE_HYPRE
+    if (backend == "auto") backend = "pfmg";
+    if (backend == "pfmg") {
+      auto pfmg = std::make_shared<PressurePfmg>(tol, max_it);
+      solve_ = [pfmg](const PressureSystem& sys, std::vector<double>& x) { return (*pfmg)(sys, x); };
+    }
+#else
+    if (backend == "pfmg")
+      throw sdk::ParameterError("solver/backend: \"pfmg\" needs hypre, and this domel was built without it (Debian "
+                                "package libhypre-dev); use \"cg\" or \"auto\"");
+    if (backend == "auto") backend = "cg";
+#endif
+    if (backend == "cg") {
+      auto cg = std::make_shared<PressureCg>(tol, max_it);
+      solve_ = [cg](const PressureSystem& sys, std::vector<double>& x) { return (*cg)(sys, x); };
+    }
+    backend_ = backend;
     solver_ = std::make_unique<VansSolver>(s, std::move(blocked));
     // every inlet must keep at least one open face
     for (int side = 0; side < 6; ++side) {
@@ -245,8 +268,7 @@ class Vans {
     // 3. the fluid over the interval
     const double dt = ex.interval / substeps_;
     for (int s = 0; s < substeps_; ++s) {
-      last_solve_ = f.step(dt, static_cast<double>(s) / substeps_, static_cast<double>(s + 1) / substeps_,
-                           std::ref(cg_));
+      last_solve_ = f.step(dt, static_cast<double>(s) / substeps_, static_cast<double>(s + 1) / substeps_, solve_);
       iterations_ += last_solve_.iterations;
     }
     ++exchanges_;
@@ -350,6 +372,8 @@ class Vans {
   }
 
   const VansSolver& solver() const { return *solver_; }
+  /// The pressure solve in use: "cg" or "pfmg".
+  const std::string& backend() const { return backend_; }
 
  private:
   static double volume(double r) { return 4.0 / 3.0 * M_PI * r * r * r; }
@@ -469,7 +493,8 @@ class Vans {
 
   sdk::Host host_;
   std::unique_ptr<VansSolver> solver_;
-  PressureCg cg_;
+  PressureSolver solve_;
+  std::string backend_;
   DragLaw law_ = DragLaw::di_felice;
   bool scaling_ = true, pressure_force_ = true, two_way_ = true;
   double eps_min_ = 0.3, cfl_ = 0.5;

@@ -66,6 +66,8 @@ enum class FaceKind : std::uint8_t { interior, outlet, wall, inlet };
 /// Solves A x = b for the pressure correction: A sparse SPD, given row by
 /// row as (diag, neighbours). Returns iterations and relative residual.
 struct PressureSystem {
+  std::array<int, 3> n{0, 0, 0};                      ///< the grid's cells per axis
+  std::vector<std::size_t> cell_of;                   ///< per unknown: its cell (i + nx (j + ny k))
   std::vector<double> diag;                           ///< per unknown
   std::vector<std::vector<std::pair<std::size_t, double>>> off;  ///< per unknown: (column, value), value < 0
   std::vector<double> rhs;
@@ -204,6 +206,10 @@ class VansSolver {
       });
     // pressure system
     PressureSystem sys;
+    sys.n = g.n;
+    sys.cell_of.assign(n_unknowns_, 0);
+    for (std::size_t c = 0; c < g.cells(); ++c)
+      if (!blocked_[c]) sys.cell_of[unknown_[c]] = c;
     sys.diag.assign(n_unknowns_, 0.0);
     sys.off.assign(n_unknowns_, {});
     sys.rhs.assign(n_unknowns_, 0.0);
@@ -238,8 +244,9 @@ class VansSolver {
           sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
         }
     {
-      // the divergence a velocity error of 1e-6 of the flow's scale (or of
-      // 1 mm/s at rest) would give, over the whole system
+      // the flow's own rate of strain (or 1 mm/s over a cell at rest), over
+      // the whole system: the solve stops at the tolerance times this, so a
+      // nearly divergence-free predictor is not iterated on to round-off
       const auto um = max_speed();
       double rate = 0, hmin = g.h[0];
       for (int a = 0; a < 3; ++a) {

@@ -13,7 +13,8 @@ inlet on z_min and a pressure outlet on z_max):
   - the bed's mean void fraction below its top, same window.
 Prints a table and, with --plot, draws dp against U with the buoyant weight
 per area and Ergun's fixed-bed line at the void fraction of the slowest run.
-Usage: analyse_fbed.py [--from T] [--plot PNG] U=folder [U=folder ...]"""
+Usage: analyse_fbed.py [--from T] [--plot PNG] label=folder [label=folder ...]
+(the label names the run in the table; U is read from the scenario's inlet)."""
 import argparse, glob, json, math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -56,14 +57,15 @@ def main():
     args = ap.parse_args()
     rows = []
     for spec in args.runs:
-        u, folder = spec.split("=", 1)
+        label, folder = spec.split("=", 1)
         s = json.load(open(os.path.join(folder, "summary.json")))
         doc = json.load(open(s["scenario"]["file"]))
         fl = doc["fluid"]
         rho_f, mu = fl["density"], fl["viscosity"]
         g = abs(doc["gravity"][2])
         mat = doc["materials"][doc["subdomains"][0]["material"]]
-        d = doc["subdomains"][0]["insert"][0]["diameter"]
+        d = doc["subdomains"][0]["insert"][0]["diameter"] * doc["subdomains"][0].get("coarse_grain", 1)
+        u = fl["boundaries"]["z_min"]["velocity"][2]
         n = s["particles"]
         lo, hi = fl["grid"]["min"], fl["grid"]["max"]
         area = (hi[0] - lo[0]) * (hi[1] - lo[1])
@@ -71,12 +73,12 @@ def main():
         dps, epss = analyse(folder, args.t_from, rho_f, g)
         mean = sum(dps) / len(dps)
         sd = math.sqrt(sum((x - mean) ** 2 for x in dps) / max(len(dps) - 1, 1))
-        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, d, rho_f, mu, mat["density"], g))
+        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label))
     rows.sort()
-    print("| U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps |")
-    print("|---|---|---|---|")
-    for u, mean, sd, nf, eps, w, *_ in rows:
-        print(f"| {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} |")
+    print("| run | U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps |")
+    print("|---|---|---|---|---|")
+    for u, mean, sd, nf, eps, w, label in rows:
+        print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} |")
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")

@@ -128,7 +128,7 @@ struct BedResult {
 /// below 1e-3 s even at Re_p = 1); measured at the end
 /// from the coupler's fields: the slope of the pressure over the bed's inner
 /// cells (two cells kept clear of each end of the bed).
-BedResult fixed_bed(const std::string& law, double us) {
+BedResult fixed_bed(const std::string& law, double us, const std::string& backend = "auto") {
   const double d = 1e-3;
   json doc = dt::scenario(dt::hertz_mindlin(), 1e-4, 0.5, 0.5, 1e6, 0.3, kRhoP);
   doc["gravity"] = {0, 0, -kG};
@@ -147,7 +147,8 @@ BedResult fixed_bed(const std::string& law, double us) {
                     {"z_max", {{"type", "pressure_outlet"}}}}},
                   {"drag", {{"law", law}}},
                   {"initial_velocity", {0, 0, us}},
-                  {"write_interval", 0}};
+                  {"write_interval", 0},
+                  {"solver", {{"backend", backend}}}};
   doc["run"] = {{"duration", 0.05}};
   auto sim = dt::build(doc);
   run(*sim, "bed");
@@ -207,4 +208,21 @@ TEST(FluidVans, FixedBedPressureGradientFollowsTheDragLaw) {
       EXPECT_NEAR(r.eps, 1 - M_PI / 6, 0.01) << "the lattice's void fraction";
     }
   }
+}
+
+// The two pressure solves (Eigen's incomplete-Cholesky CG and hypre's PFMG
+// multigrid) give the same bed to their tolerance (1e-8 relative each, so
+// 1e-6 between them). Skipped when this build has no hypre.
+TEST(FluidVans, MultigridAndConjugateGradientSolvesAgree) {
+  const double us = 20 * kMu / (kRhoF * 1e-3);
+  BedResult pfmg{};
+  try {
+    pfmg = fixed_bed("gidaspow", us, "pfmg");
+  } catch (const dp::ConfigError& e) {
+    if (std::string(e.what()).find("needs hypre") != std::string::npos) GTEST_SKIP() << e.what();
+    throw;
+  }
+  const BedResult cg = fixed_bed("gidaspow", us, "cg");
+  std::printf("[pressure solves] -dp/dz cg %.9g, pfmg %.9g Pa/m\n", cg.gradient, pfmg.gradient);
+  EXPECT_NEAR(pfmg.gradient, cg.gradient, 1e-6 * cg.gradient);
 }
