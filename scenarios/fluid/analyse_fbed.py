@@ -5,9 +5,11 @@ summary.json of runs at several inlet velocities.
 
 For each run (an output folder of a scenario whose fluid block has a velocity
 inlet on z_min and a pressure outlet on z_max):
-  - the pressure at the inlet face is extrapolated from the two lowest cell
-    layers (p0 + (p0 - p1)/2), the pressure above the bed is the mean of the
-    first layer whose void fraction exceeds 0.999; their difference less the
+  - below the bed: the last clear layer under it (a plenum under the DEM
+    floor; best) or, when the bed starts in the first layer, the inlet face's
+    pressure extrapolated from the two lowest layers (p0 + (p0 - p1)/2, crude
+    when the bed is only a few layers tall); above the bed: the first clear
+    layer over it (void fraction above 0.999); their difference less the
     gas's own hydrostatic rho_f g dz is the bed's pressure drop;
   - it is averaged over the frames from --from (default 0.3 s) to the end;
   - the bed's mean void fraction below its top, same window.
@@ -41,11 +43,15 @@ def analyse(folder, t_from, rho_f, g):
             continue
         dims, origin, spacing, a = read_vti(f)
         p, e = layer_means(dims, a, "pressure"), layer_means(dims, a, "void_fraction")
-        top = next((k for k in range(1, dims[2]) if e[k] > 0.999), dims[2] - 1)
-        p_inlet = p[0] + 0.5 * (p[0] - p[1])
+        first = next((k for k in range(dims[2]) if e[k] <= 0.999), 0)
+        top = next((k for k in range(first + 1, dims[2]) if e[k] > 0.999), dims[2] - 1)
+        if first > 0:
+            p_low, z_low = p[first - 1], origin[2] + (first - 0.5) * spacing[2]
+        else:
+            p_low, z_low = p[0] + 0.5 * (p[0] - p[1]), origin[2]
         z_top = origin[2] + (top + 0.5) * spacing[2]
-        dps.append(p_inlet - p[top] - rho_f * g * (z_top - origin[2]))
-        epss.append(sum(e[:top]) / max(top, 1))
+        dps.append(p_low - p[top] - rho_f * g * (z_top - z_low))
+        epss.append(sum(e[first:top]) / max(top - first, 1))
     return dps, epss
 
 
@@ -73,12 +79,25 @@ def main():
         dps, epss = analyse(folder, args.t_from, rho_f, g)
         mean = sum(dps) / len(dps)
         sd = math.sqrt(sum((x - mean) ** 2 for x in dps) / max(len(dps) - 1, 1))
-        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label))
+        # the bed's height at the end from the state file: the 95th percentile
+        # of the particles' tops above the lowest particle's bottom
+        height = float("nan")
+        state = s.get("outputs", {}).get("state", {})
+        if state:
+            zs, r0 = [], None
+            for line in open(os.path.join(folder, list(state.values())[0])):
+                if line.startswith("#") or line.startswith("id"):
+                    continue
+                f = line.split(",")
+                zs.append((float(f[3]) + float(f[4]), float(f[3]) - float(f[4])))
+            tops = sorted(z[0] for z in zs)
+            height = tops[int(0.95 * (len(tops) - 1))] - min(z[1] for z in zs)
+        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label, height))
     rows.sort()
-    print("| run | U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps |")
-    print("|---|---|---|---|---|")
-    for u, mean, sd, nf, eps, w, label in rows:
-        print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} |")
+    print("| run | U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps (layers) | bed height at the end [mm] |")
+    print("|---|---|---|---|---|---|")
+    for u, mean, sd, nf, eps, w, label, height in rows:
+        print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} | {1e3 * height:.1f} |")
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")
