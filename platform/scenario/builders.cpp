@@ -905,6 +905,59 @@ std::optional<FluidSpec> build_fluid(Build& b) {
   } catch (const PluginError& e) {
     b.ck.add("/fluid", e.what());
   }
+  // The coupler's grid (from its fields, when it reports them) must hold
+  // where the particles start: every insertion and pour region of its
+  // levels, and the walls' box when they enclose the domain.
+  try {
+    domel_fluid_fields_v1 f{};
+    if (spec.model->fluid_fields(f) && f.nx > 0 && f.ny > 0 && f.nz > 0) {
+      const double glo[3] = {f.origin[0], f.origin[1], f.origin[2]};
+      const double ghi[3] = {f.origin[0] + f.nx * f.spacing[0], f.origin[1] + f.ny * f.spacing[1],
+                             f.origin[2] + f.nz * f.spacing[2]};
+      auto check = [&](const double lo[3], const double hi[3], const std::string& what) {
+        for (int a = 0; a < 3; ++a)
+          if (lo[a] < glo[a] - 1e-12 || hi[a] > ghi[a] + 1e-12) {
+            b.ck.add("/fluid", "the fluid grid [" + fmt_num(glo[a]) + ", " + fmt_num(ghi[a]) + "] m along " +
+                                   std::string(1, "xyz"[a]) + " does not cover " + what + " ([" + fmt_num(lo[a]) +
+                                   ", " + fmt_num(hi[a]) + "] m)",
+                     "enlarge the coupler's grid to the particles' whole domain");
+            return;
+          }
+      };
+      auto region_box = [](const domel_region_v1& r, double lo[3], double hi[3]) {
+        for (int k = 0; k < 3; ++k) {
+          const bool along = r.shape == 1 || k == static_cast<int>(r.axis);
+          lo[k] = along ? r.lo[k] : r.center[k] - r.radius;
+          hi[k] = along ? r.hi[k] : r.center[k] + r.radius;
+        }
+      };
+      for (std::size_t k : spec.levels) {
+        const json& sd = b.doc["subdomains"][k];
+        const std::string base = idx("/subdomains", k);
+        double lo[3], hi[3];
+        if (sd.contains("insert"))
+          for (std::size_t q = 0; q < sd["insert"].size(); ++q)
+            if (sd["insert"][q].contains("region")) {
+              region_box(make_region(sd["insert"][q]["region"]), lo, hi);
+              check(lo, hi, "the insertion region " + idx(base + "/insert", q));
+            }
+        if (sd.contains("pour"))
+          for (std::size_t q = 0; q < sd["pour"].size(); ++q) {
+            region_box(make_region(sd["pour"][q]["insert"]["region"]), lo, hi);
+            check(lo, hi, "the pour region " + idx(base + "/pour", q));
+          }
+      }
+      bool enclosed = false;
+      for (const auto& w : sim.walls)
+        enclosed = enclosed || w.shape == WallPrimitive::Shape::cylinder_inside ||
+                   w.shape == WallPrimitive::Shape::cone_inside || w.shape == WallPrimitive::Shape::mesh;
+      double lo[3], hi[3];
+      if (enclosed && b.doc.value("deletion_regions", json::array()).empty() && domain_bounds(b, lo, hi))
+        check(lo, hi, "the walls' domain");
+    }
+  } catch (const PluginError& e) {
+    b.ck.add("/fluid", e.what());
+  }
   spec.one_level_per_call = b.registry.libraries()[m->library].abi_minor < 2;
   spec.used = {{"model", model},
                {"version", m->version},
