@@ -20,8 +20,9 @@
 //    (refreshed by the host every step) and the held force m "held"; it logs
 //    each level's first particle's interval-mean velocity; its limits
 //    callback reports "max_interval" (after the first exchange
-//    "max_interval_later" when given); its fields callback a 1x1x2 grid with
-//    the exchange count and the flow.
+//    "max_interval_later" when given); its fields callback a 1x1x2 grid
+//    over [-1, 1.5] x [-1, 1.5] x [-1, 4] m with the exchange count and the
+//    flow.
 #include <domel/sdk/plugin.hpp>
 
 #include <cmath>
@@ -182,7 +183,8 @@ class TestLinearDrag {
     data_[1] = flow_;
     out.field_count = 2;
     out.nx = 1, out.ny = 1, out.nz = 2;
-    for (int d = 0; d < 3; ++d) out.origin[d] = 0.0, out.spacing[d] = 0.5;
+    // the fluid's whole domain: it holds every test scenario's particles
+    for (int d = 0; d < 3; ++d) out.origin[d] = -1.0, out.spacing[d] = 2.5;
     out.names = names, out.units = units, out.components = components, out.data = data_;
   }
 

@@ -379,7 +379,9 @@ typedef domel_status (*domel_fluid_exchange_fn)(void* instance, domel_fluid_exch
 /** The coupler's own fields for output (ABI 2.2), cell-centred on a uniform
  *  grid: cell (ix, iy, iz) has index ix + nx (iy + ny iz), as
  *  domel_cell_grid_v1. The coupler owns the memory; it stays valid until the
- *  next call into the instance. The host writes them as VTK image data. */
+ *  next call into the instance. The host writes them as VTK image data.
+ *  The grid is the fluid's domain: the host also calls this once before the
+ *  run and refuses a scenario whose particles start outside it. */
 typedef struct domel_fluid_fields_v1 {
   uint32_t struct_size;
   uint32_t field_count;       /**< [out] */
