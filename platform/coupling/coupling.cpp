@@ -4,6 +4,8 @@
 // controller views (§5.3, §5.4) and the interface balance.
 #include "coupling/coupling.hpp"
 
+#include "core/abi_views.hpp"
+
 #include "core/error.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
@@ -455,17 +457,7 @@ void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& co
       cell[q] = c < 0 ? UINT32_MAX : static_cast<std::uint32_t>(c);
     }
     force.x.assign(n, 0.0), force.y.assign(n, 0.0), force.z.assign(n, 0.0);
-    domel_particles_v1 v{};
-    v.struct_size = sizeof v;
-    v.n = n;
-    v.id = s.id.data();
-    v.x = s.x.data(), v.y = s.y.data(), v.z = s.z.data();
-    v.vx = s.vx.data(), v.vy = s.vy.data(), v.vz = s.vz.data();
-    v.mass = s.mass.data();
-    v.radius = s.radius.data();
-    v.cell = cell.data();
-    v.fx = force.x.data(), v.fy = force.y.data(), v.fz = force.z.data();
-    return v;
+    return particles_view(s, cell.data(), force.x.data(), force.y.data(), force.z.data());
   };
   domel_particles_v1 pf = particle_view(fine, cell_f_, force_f);
   domel_particles_v1 pc = particle_view(coarse, cell_c_, force_c);

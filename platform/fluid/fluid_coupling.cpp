@@ -4,6 +4,7 @@
 // fields.
 #include "fluid/fluid_coupling.hpp"
 
+#include "core/abi_views.hpp"
 #include "core/error.hpp"
 #include "core/particle_store.hpp"
 #include "io/cell_grid_output.hpp"
@@ -84,16 +85,7 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
     }
     for (std::size_t q = kSx; q <= kSt; ++q) std::fill(x[a + q].begin(), x[a + q].end(), 0.0);
     domel_particles_v1& p = particles[L];
-    p = domel_particles_v1{};
-    p.struct_size = sizeof p;
-    p.n = n;
-    p.id = s.id.data();
-    p.x = s.x.data(), p.y = s.y.data(), p.z = s.z.data();
-    p.vx = s.vx.data(), p.vy = s.vy.data(), p.vz = s.vz.data();
-    p.mass = s.mass.data();
-    p.radius = s.radius.data();
-    p.cell = nullptr;
-    p.fx = x[a + kFx].data(), p.fy = x[a + kFy].data(), p.fz = x[a + kFz].data();
+    p = particles_view(s, nullptr, x[a + kFx].data(), x[a + kFy].data(), x[a + kFz].data());
     levels[L] = domel_level_v1{sizeof(domel_level_v1), 0, sd.name().c_str(), sd.coarse_grain(), nullptr, &p};
     drags[L] = domel_fluid_drag_v1{sizeof(domel_fluid_drag_v1), 0, n, x[a + kBeta].data(), x[a + kUx].data(),
                                    x[a + kUy].data(), x[a + kUz].data()};

@@ -15,6 +15,8 @@
 #include "scenario/scenario.hpp"
 #include "scheduler/simulation.hpp"
 
+#include "log_capture.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/sinks/ostream_sink.h>
@@ -86,17 +88,7 @@ dp::RunResult run(dp::Simulation& sim, const std::string& name) {
   return sim.run(o, registry());
 }
 
-struct LogCapture {
-  LogCapture() : old(spdlog::default_logger()) {
-    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
-    auto logger = std::make_shared<spdlog::logger>("capture", sink);
-    logger->set_level(spdlog::level::debug);
-    spdlog::set_default_logger(logger);
-  }
-  ~LogCapture() { spdlog::set_default_logger(old); }
-  std::ostringstream text;
-  std::shared_ptr<spdlog::logger> old;
-};
+using domel::test::LogCapture;
 
 std::string config_error(const json& doc) {
   try {

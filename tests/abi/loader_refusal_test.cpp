@@ -12,6 +12,8 @@
 #include "loader/plugin_registry.hpp"
 #include "scenario/scenario.hpp"
 
+#include "log_capture.hpp"
+
 #include <domel/sdk/abi.h>
 
 #include <gtest/gtest.h>
@@ -479,18 +481,7 @@ struct Level {
   domel_level_v1 level{};
 };
 
-/// Captures the default logger's output while alive.
-struct LogCapture {
-  LogCapture() : old(spdlog::default_logger()) {
-    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
-    auto logger = std::make_shared<spdlog::logger>("capture", sink);
-    logger->set_level(spdlog::level::debug);
-    spdlog::set_default_logger(logger);
-  }
-  ~LogCapture() { spdlog::set_default_logger(old); }
-  std::ostringstream text;
-  std::shared_ptr<spdlog::logger> old;
-};
+using domel::test::LogCapture;
 
 }  // namespace
 
