@@ -30,35 +30,14 @@ module_name=libdomel_fluid_uniform_stokes.so
 
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/domel_third_party_fluid.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
-prefix=$tmp/prefix
 
 fail() {
   echo "third_party_fluid_check: FAIL: $*" >&2
   exit 1
 }
 
-echo "== 1. install $build into $prefix"
-cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1 || {
-  cat "$tmp/install.log" >&2
-  fail "cmake --install failed"
-}
-domel=$prefix/bin/domel
-
-echo "== 2. build $project against the installed SDK"
-generator=()
-if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
-cmake -S "$project" -B "$tmp/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/configure.log" 2>&1 || {
-  cat "$tmp/configure.log" >&2
-  fail "configuring the example failed"
-}
-grep -q "domel_sdk_DIR:PATH=$prefix/lib/cmake/domel_sdk" "$tmp/build/CMakeCache.txt" ||
-  fail "find_package(domel_sdk) did not pick the installed package"
-nice cmake --build "$tmp/build" -j1 >"$tmp/build.log" 2>&1 || {
-  cat "$tmp/build.log" >&2
-  fail "building the example failed"
-}
-[[ -f "$tmp/build/$module_name" ]] || fail "no $module_name in $tmp/build"
+source "$(dirname "${BASH_SOURCE[0]}")/example_build.sh"
+install_and_build_example "$build" "$project" "$tmp" "$module_name"
 
 cp "$project/scenario.json" "$tmp/build/scenario.json"
 python3 - "$tmp/build/scenario.json" "$tmp/build/scenario_unscaled.json" <<'PY' || fail "could not write scenario_unscaled.json"

@@ -29,38 +29,14 @@ module_name=libdomel_rolling_epsd.so
 
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/domel_third_party.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
-prefix=$tmp/prefix
 
 fail() {
   echo "third_party_rolling_check: FAIL: $*" >&2
   exit 1
 }
 
-echo "== 1. install $build into $prefix"
-cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1 || {
-  cat "$tmp/install.log" >&2
-  fail "cmake --install failed"
-}
-[[ -f "$prefix/lib/cmake/domel_sdk/domel_sdkConfig.cmake" ]] || fail "not installed: lib/cmake/domel_sdk/domel_sdkConfig.cmake"
-[[ -x "$prefix/bin/domel" ]] || fail "not installed: bin/domel"
-domel=$prefix/bin/domel
-
-echo "== 2. build $project against the installed SDK"
-generator=()
-if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
-cmake -S "$project" -B "$tmp/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$prefix" >"$tmp/configure.log" 2>&1 || {
-  cat "$tmp/configure.log" >&2
-  fail "configuring the example failed"
-}
-grep -q "domel_sdk_DIR:PATH=$prefix/lib/cmake/domel_sdk" "$tmp/build/CMakeCache.txt" ||
-  fail "find_package(domel_sdk) did not pick the installed package: $(grep domel_sdk_DIR "$tmp/build/CMakeCache.txt")"
-nice cmake --build "$tmp/build" -j1 >"$tmp/build.log" 2>&1 || {
-  cat "$tmp/build.log" >&2
-  fail "building the example failed"
-}
-[[ -f "$tmp/build/$module_name" ]] || fail "no $module_name in $tmp/build"
-echo "built $tmp/build/$module_name"
+source "$(dirname "${BASH_SOURCE[0]}")/example_build.sh"
+install_and_build_example "$build" "$project" "$tmp" "$module_name"
 
 echo "== 3. run scenario.json with the plugin loaded by path, as LIGGGHTS epsd and as epsd2"
 cp "$project/scenario.json" "$tmp/build/scenario.json"
