@@ -952,7 +952,8 @@ std::optional<FluidSpec> build_fluid(Build& b) {
         enclosed = enclosed || w.shape == WallPrimitive::Shape::cylinder_inside ||
                    w.shape == WallPrimitive::Shape::cone_inside || w.shape == WallPrimitive::Shape::mesh;
       double lo[3], hi[3];
-      if (enclosed && b.doc.value("deletion_regions", json::array()).empty() && domain_bounds(b, lo, hi))
+      const bool deletions = b.doc.contains("deletion_regions") && !b.doc["deletion_regions"].empty();
+      if (enclosed && !deletions && domain_bounds(b, lo, hi))
         check(lo, hi, "the walls' domain");
     }
   } catch (const PluginError& e) {
