@@ -216,6 +216,7 @@ nlohmann::json FluidCoupling::summary() const {
                       {"interval_s", spec_.interval},
                       {"exchanges", exchanges_},
                       {"coupler_seconds", seconds_},
+                      {"coupler_seconds_per_exchange", exchanges_ ? seconds_ / static_cast<double>(exchanges_) : 0.0},
                       {"levels", levels}};
   if (has_limits_)
     j["limits"] = {{"max_interval_s", last_limits_.max_interval},

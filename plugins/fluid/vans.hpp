@@ -183,6 +183,9 @@ class Vans {
       solve_ = [cg](const PressureSystem& sys, std::vector<double>& x) { return (*cg)(sys, x); };
     }
     backend_ = backend;
+    host_.info("pressure solve: " + std::string(backend == "pfmg" ? "hypre PFMG-preconditioned CG" :
+                                                 "Eigen conjugate gradient, incomplete Cholesky") +
+               " (solver.backend " + solver.value("backend", std::string("auto")) + ")");
     solver_ = std::make_unique<VansSolver>(s, std::move(blocked));
     // every inlet must keep at least one open face
     for (int side = 0; side < 6; ++side) {
