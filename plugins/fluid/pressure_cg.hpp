@@ -38,11 +38,11 @@ class PressureCg {
                              Eigen::IncompleteCholesky<double>>
         cg;
     // relative to |b|, but never below tol x the system's reference norm
-    const double bn = b.norm();
-    cg.setTolerance(bn > 0 ? tol_ * std::max(1.0, sys.reference_norm / bn) : tol_);
+    const double bn = sys.rhs_norm();
+    cg.setTolerance(sys.relative_tolerance(tol_, bn));
     cg.setMaxIterations(max_);
     Eigen::VectorXd sol = Eigen::VectorXd::Zero(n);
-    const bool trivial = bn <= tol_ * sys.reference_norm;
+    const bool trivial = sys.trivial(tol_, bn);
     if (!trivial) {
       cg.compute(A);
       sol = cg.solveWithGuess(b, last_);

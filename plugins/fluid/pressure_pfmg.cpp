@@ -110,12 +110,10 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
       s.values[7 * c + e] = v;
     }
   }
-  double bn = 0;
-  for (double v : sys.rhs) bn += v * v;
-  bn = std::sqrt(bn);
+  const double bn = sys.rhs_norm();
   x.assign(sys.diag.size(), 0.0);
   SolveReport rep;
-  if (bn <= tol_ * sys.reference_norm) return rep;  // nothing to correct
+  if (sys.trivial(tol_, bn)) return rep;  // nothing to correct
   HYPRE_StructMatrix A;
   HYPRE_StructVector b, xv;
   HYPRE_StructMatrixCreate(MPI_COMM_SELF, s.grid, s.stencil, &A);
@@ -135,7 +133,7 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
   HYPRE_StructVectorAssemble(xv);
   HYPRE_StructSolver pcg, pfmg;
   HYPRE_StructPCGCreate(MPI_COMM_SELF, &pcg);
-  HYPRE_StructPCGSetTol(pcg, tol_ * std::max(1.0, sys.reference_norm / bn));
+  HYPRE_StructPCGSetTol(pcg, sys.relative_tolerance(tol_, bn));
   HYPRE_StructPCGSetMaxIter(pcg, max_);
   HYPRE_StructPCGSetTwoNorm(pcg, 1);
   HYPRE_StructPFMGCreate(MPI_COMM_SELF, &pfmg);

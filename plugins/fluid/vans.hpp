@@ -207,14 +207,7 @@ class Vans {
     if (ex.struct_size < offsetof(domel_fluid_exchange_v1, v_mean) + sizeof(ex.v_mean) ||
         !(ex.host_flags & DOMEL_FLUID_HOST_DRAG))
       throw std::runtime_error("the host offers no linearised drag (domel ABI 2.2 or later is needed)");
-    if (!gravity_set_) {
-      // the solver's gravity and hydrostatic start need the scenario's gravity
-      VansSolver::Settings s = solver_->settings();
-      for (int d = 0; d < 3; ++d) s.gravity[d] = ex.gravity[d];
-      std::vector<std::uint8_t> blocked = solver_->blocked();
-      solver_ = std::make_unique<VansSolver>(s, std::move(blocked));
-      gravity_set_ = true;
-    }
+    if (exchanges_ == 0) solver_->set_gravity({ex.gravity[0], ex.gravity[1], ex.gravity[2]});
     VansSolver& f = *solver_;
     const MacGrid& g = f.grid();
     const double V = g.cell_volume();
@@ -240,6 +233,8 @@ class Vans {
     std::vector<double>& eps = f.eps_mut();
     for (std::size_t c = 0; c < g.cells(); ++c) eps[c] = std::max(eps_min_, 1.0 - phi[c]);
     if (exchanges_ == 0) f.keep_old_void_fraction();  // no d(eps)/dt at the start
+    // the unresolved CFD-DEM rule of thumb: cells at least about 3 parcel
+    // diameters wide (docs/design/dem_cfd_research.md §4; Peng et al. 2014)
     if (!warned_resolution_ && dmax > 0 && std::min({g.h[0], g.h[1], g.h[2]}) < 3 * dmax) {
       warned_resolution_ = true;
       std::ostringstream os;
@@ -272,7 +267,6 @@ class Vans {
     const double dt = ex.interval / substeps_;
     for (int s = 0; s < substeps_; ++s) {
       last_solve_ = f.step(dt, static_cast<double>(s) / substeps_, static_cast<double>(s + 1) / substeps_, solve_);
-      iterations_ += last_solve_.iterations;
     }
     ++exchanges_;
     // 4. forces back
@@ -344,6 +338,13 @@ class Vans {
     out.names = names, out.units = units, out.components = components, out.data = data_;
   }
 
+  // The limits (docs/fluid.md, "Stability"): the advective Courant number of
+  // explicit first-order upwinding, sum_a |u_a| dt/dx_a <= 1, kept at `cfl`
+  // (0.5 by default) for margin; the explicit diffusion limit of the 7-point
+  // Laplacian, nu dt sum_a 2/dx_a^2 <= 1 (von Neumann analysis of FTCS,
+  // Ferziger & Peric, Computational Methods for Fluid Dynamics, ch. 6); and a
+  // choice of domel's: particles move at most half a cell per interval, so
+  // that d(eps)/dt in the pressure equation stays resolved.
   void limits(domel_fluid_limits_v1& out) {
     const VansSolver& f = *solver_;
     const MacGrid& g = f.grid();
@@ -502,8 +503,7 @@ class Vans {
   bool scaling_ = true, pressure_force_ = true, two_way_ = true;
   double eps_min_ = 0.3, cfl_ = 0.5;
   int substeps_ = 1;
-  bool gravity_set_ = false;
-  std::uint64_t exchanges_ = 0, iterations_ = 0;
+  std::uint64_t exchanges_ = 0;
   SolveReport last_solve_;
   double vmax_ = 0;
   bool warned_resolution_ = false, warned_validity_ = false;

@@ -74,6 +74,20 @@ struct PressureSystem {
   /// |rhs| below which the system counts as solved [1/s]: the round-off of
   /// a fluid at rest would otherwise be iterated on as if it were flow
   double reference_norm = 0;
+
+  /// |rhs| (2-norm).
+  double rhs_norm() const {
+    double s = 0;
+    for (double v : rhs) s += v * v;
+    return std::sqrt(s);
+  }
+  /// Whether rhs is below `tol` x the reference: nothing to solve.
+  bool trivial(double tol, double bnorm) const { return bnorm <= tol * reference_norm; }
+  /// The relative tolerance a solver stops at: `tol`, but never below `tol`
+  /// x the reference norm in absolute terms.
+  double relative_tolerance(double tol, double bnorm) const {
+    return bnorm > 0 ? tol * std::max(1.0, reference_norm / bnorm) : tol;
+  }
 };
 struct SolveReport {
   int iterations = 0;
@@ -113,12 +127,20 @@ class VansSolver {
     unknown_.assign(g.cells(), SIZE_MAX);
     for (std::size_t c = 0; c < g.cells(); ++c)
       if (!blocked_[c]) unknown_[c] = n_unknowns_++;
-    // start: the initial velocity on the free faces, the inlet values on inlets;
-    // the pressure hydrostatic from the first outlet
+    // start: the initial velocity on the free faces, the inlet values on inlets
     for (int a = 0; a < 3; ++a)
       for (std::size_t f = 0; f < g.faces(a); ++f)
         u_[a][f] = kind_[a][f] == FaceKind::inlet ? inlet_value_[a][f]
                    : (kind_[a][f] == FaceKind::wall ? 0.0 : s_.initial_velocity[a]);
+    set_gravity(s_.gravity);
+  }
+
+  /// The gravity of the fluid's momentum equation, and the pressure reset to
+  /// hydrostatic from the first outlet (the coupler learns the scenario's
+  /// gravity at its first exchange).
+  void set_gravity(const std::array<double, 3>& gravity) {
+    s_.gravity = gravity;
+    const MacGrid& g = s_.grid;
     for (int side = 0; side < 6; ++side)
       if (s_.sides[side].type == Boundary::pressure_outlet) {
         const int a = side / 2;
@@ -133,7 +155,7 @@ class VansSolver {
               for (int d = 0; d < 3; ++d) p += s_.rho * s_.gravity[d] * (x[d] - ref[d]);
               p_[g.cell(i, j, k)] = p;
             }
-        break;
+        return;
       }
   }
 
@@ -187,7 +209,7 @@ class VansSolver {
       for_faces(a, [&](int i, int j, int k, std::size_t f) {
         const FaceKind kd = kind_[a][f];
         if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
-        const double ef1 = face_eps(e1, a, i, j, k), ef0 = face_eps(e0, a, i, j, k);
+        const double ef1 = face_eps(e1, a, i, j, k);
         const double un = u_[a][f];
         // advection (first-order upwind) and diffusion of u_a
         double adv = 0, lap = 0;
@@ -199,7 +221,6 @@ class VansSolver {
         }
         const double gradp = face_gradient(p_, a, i, j, k, kd);
         const double R = -s_.rho * ef1 * adv + s_.mu * ef1 * lap - ef1 * gradp + s_.rho * ef1 * s_.gravity[a];
-        (void)ef0;
         const double K = K_[a][f];
         us[a][f] = (s_.rho * ef1 * un / dt + R + Ku_[a][f]) / (s_.rho * ef1 / dt + K);
         A[a][f] = ef1 * dt / (s_.rho * ef1 + K * dt);
@@ -220,7 +241,6 @@ class VansSolver {
           if (blocked_[c]) continue;
           const std::size_t P = unknown_[c];
           double div = 0;
-          const int idx[3] = {i, j, k};
           for (int a = 0; a < 3; ++a) {
             for (int s = 0; s < 2; ++s) {  // s = 0: the face on the low side, 1: the high side
               int fi[3] = {i, j, k};
@@ -239,7 +259,6 @@ class VansSolver {
                 sys.diag[P] += ef * A[a][f] / (g.h[a] * 0.5 * g.h[a]);
               }
             }
-            (void)idx;
           }
           sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
         }
