@@ -167,3 +167,19 @@ TEST(Vans, BadBoundariesAndObstaclesAreRefusedNamingTheKey) {
   p["obstacles"] = json::array({json{{"box", speck}}});
   EXPECT_NE(refusal(p).find("obstacles/0: blocks no cell"), std::string::npos) << refusal(p);
 }
+
+// A particle outside the fluid grid (it left through a side with no deletion
+// region) stops the exchange with a message naming it and what to do.
+TEST(Vans, AParticleOutsideTheGridIsReportedByIdAndPosition) {
+  Vans v{domel::sdk::Params(base())};
+  Particles ps(3);
+  ps.z[1] = 0.09;  // above the grid's top at 0.08 m
+  try {
+    exchange(v, ps, 0.0, 1e-4);
+    ADD_FAILURE() << "a particle outside the grid was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("particle 2 of 'bed' at ("), std::string::npos) << m;
+    EXPECT_NE(m.find("is outside the fluid grid; make the grid cover the particles' domain"), std::string::npos) << m;
+  }
+}
