@@ -427,6 +427,26 @@ void build_particle_flow(Build& b) {
         for (int a = 0; a < 2; ++a) pl.rate_window[a] = d["rate_window"][a].get<double>();
       flow.planes.push_back(pl);
     }
+  if (out.contains("region_mass"))
+    for (std::size_t i = 0; i < out["region_mass"].size(); ++i) {
+      const json& d = out["region_mass"][i];
+      RegionMassProbe rm;
+      rm.name = d["name"].get<std::string>();
+      if (d.contains("subdomain"))
+        rm.subdomain = subdomain_index(b, d["subdomain"], idx("/output/region_mass", i) + "/subdomain");
+      rm.region = make_region(d["region"]);
+      if (d.contains("max_speed")) rm.max_speed = d["max_speed"].get<double>();
+      for (const auto& other : b.sim.region_mass)
+        if (other.name == rm.name)
+          b.ck.add(idx("/output/region_mass", i) + "/name", "duplicate region_mass name '" + rm.name + "'");
+      for (const auto& pl : flow.planes)
+        if (pl.name == rm.name)
+          b.ck.add(idx("/output/region_mass", i) + "/name",
+                   "region_mass name '" + rm.name + "' is also a mass_flow plane's: both would write " + rm.name +
+                       ".mass_kg to probes.csv",
+                   "rename one of them");
+      b.sim.region_mass.push_back(rm);
+    }
   flow.register_hooks(b.sim.hooks);
 }
 
@@ -842,6 +862,8 @@ void build_repose_probe(Build& b) {
                "add \"shape\": \"planar\", or remove 'crest'");
     rp.crest = c->get<double>();
   }
+  if (const json* reg = member(r, "region")) rp.region = make_region(*reg);
+  if (const json* v = member(r, "max_speed")) rp.max_speed = v->get<double>();
   b.sim.repose_probe = rp;
 }
 

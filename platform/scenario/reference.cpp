@@ -170,6 +170,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
                              {"run", "Run (`run`)"},
                              {"output", "Output (`output`)"},
                              {"mass_flow_plane", "Mass-flow plane (`output.mass_flow[]`)"},
+                             {"region_mass", "Mass in a region (`output.region_mass[]`)"},
                              {"cell_grid", "Cell grid (`output.grids[]`)"}};
   for (const auto& b : blocks) {
     const json& s = root["$defs"][b[0]];

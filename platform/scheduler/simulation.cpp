@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 
 #include "core/error.hpp"
+#include "geometry/region.hpp"
 #include "io/atomic_file.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
@@ -60,6 +61,25 @@ std::string iso_time_now() {
   return buf;
 }
 
+/// output.region_mass: kilograms and count of the particles inside the region.
+std::pair<double, std::size_t> mass_in_region(const std::vector<std::unique_ptr<Subdomain>>& subdomains,
+                                              const RegionMassProbe& rm) {
+  double kg = 0;
+  std::size_t n = 0;
+  const double v2max = rm.max_speed ? *rm.max_speed * *rm.max_speed : 0.0;
+  for (std::size_t d = 0; d < subdomains.size(); ++d) {
+    if (rm.subdomain != kAllSubdomains && rm.subdomain != d) continue;
+    const ParticleStore& s = subdomains[d]->store();
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      if (!region_contains(rm.region, s.x[k], s.y[k], s.z[k])) continue;
+      if (rm.max_speed && s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k] >= v2max) continue;
+      kg += s.mass[k];
+      ++n;
+    }
+  }
+  return {kg, n};
+}
+
 }  // namespace
 
 RunResult Simulation::run(const RunOptions& options, const PluginRegistry& registry) {
@@ -93,6 +113,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     for (const auto& c : kProbeColumns) columns.push_back(sd->name() + "." + c.name);
   if (repose_probe)
     for (const auto& sd : subdomains) columns.push_back(sd->name() + ".repose_angle_deg");
+  for (const auto& rm : region_mass) {
+    columns.push_back(rm.name + ".mass_kg");
+    columns.push_back(rm.name + ".particles");
+  }
   for (const auto& c : flow.columns()) columns.push_back(c);
   flow.start(subdomains);
 
@@ -206,6 +230,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (repose_probe)
       for (const auto& sd : subdomains)
         row.push_back(repose_angle(sd->store(), *repose_probe).value_or(std::nan("")));
+    for (const auto& rm : region_mass) {
+      const auto [kg, n] = mass_in_region(subdomains, rm);
+      row.push_back(kg);
+      row.push_back(static_cast<double>(n));
+    }
     flow.check_planes(subdomains);
     flow.append_row(t, row);
     probes->append(row);
@@ -357,6 +386,14 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       angles[sd->name()] = a ? nlohmann::json(*a) : nlohmann::json(nullptr);
     }
     summary["repose_angle_deg"] = angles;
+  }
+  if (!region_mass.empty()) {
+    nlohmann::json rj = nlohmann::json::object();
+    for (const auto& rm : region_mass) {
+      const auto [kg, n] = mass_in_region(subdomains, rm);
+      rj[rm.name] = {{"mass_kg", kg}, {"particles", n}};
+    }
+    summary["region_mass"] = rj;
   }
   summary["subdomains"] = sds;
   if (!couplings.empty()) {

@@ -43,6 +43,15 @@ struct RunResult {
   nlohmann::json summary;
 };
 
+/// output.region_mass: the mass of the particles inside a region (a heap on
+/// a plate), as <name>.mass_kg and <name>.particles in probes.csv.
+struct RegionMassProbe {
+  std::string name;
+  std::size_t subdomain = kAllSubdomains;  ///< the only subdomain counted, or all
+  domel_region_v1 region{};
+  std::optional<double> max_speed;  ///< [m/s] only particles slower than this
+};
+
 class Simulation {
  public:
   Simulation() = default;
@@ -65,6 +74,7 @@ class Simulation {
   double probe_interval = 0;
   bool write_state = false;  ///< output.state: <subdomain>_state.csv at the end (io/particle_state.hpp)
   std::optional<ReposeProbeSettings> repose_probe;  ///< adds <subdomain>.repose_angle_deg to probes.csv
+  std::vector<RegionMassProbe> region_mass;         ///< output.region_mass
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
   ParticleFlow flow;           ///< pours, deletion regions, mass-flow planes, mass balance

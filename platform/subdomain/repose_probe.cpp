@@ -2,6 +2,8 @@
 // Surface-cell cone fit of a heap (see repose_probe.hpp).
 #include "subdomain/repose_probe.hpp"
 
+#include "geometry/region.hpp"
+
 #include <cmath>
 #include <map>
 #include <utility>
@@ -9,10 +11,16 @@
 namespace domel::platform {
 
 std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSettings& settings) {
+  const double v2max = settings.max_speed ? *settings.max_speed * *settings.max_speed : 0.0;
+  auto counted = [&](std::size_t k) {
+    if (s.fixed(k)) return false;
+    if (settings.region && !region_contains(*settings.region, s.x[k], s.y[k], s.z[k])) return false;
+    return !settings.max_speed || s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k] < v2max;
+  };
   double xc = 0, yc = 0, dsum = 0;
   std::size_t n = 0;
   for (std::size_t k = 0; k < s.size(); ++k) {
-    if (s.fixed(k)) continue;
+    if (!counted(k)) continue;
     xc += s.x[k]; yc += s.y[k]; dsum += 2.0 * s.radius[k];
     ++n;
   }
@@ -22,7 +30,7 @@ std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSett
   const double cs = settings.cell * dsum / n;
   std::map<std::pair<long, long>, double> top;
   for (std::size_t k = 0; k < s.size(); ++k) {
-    if (s.fixed(k)) continue;
+    if (!counted(k)) continue;
     const std::pair<long, long> key{static_cast<long>(std::floor((s.x[k] - xc) / cs)),
                                     static_cast<long>(std::floor((s.y[k] - yc) / cs))};
     const double h = s.z[k] + s.radius[k] - settings.base_height;

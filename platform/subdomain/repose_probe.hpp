@@ -2,7 +2,9 @@
 // Angle-of-repose probe: the slope of a heap's free surface, measured the
 // way the peers' repose analysis does (its "pooled" fit; docs/validation/repose.md)
 // so that numbers compare directly:
-//  - mobile particles only; height h = z + r - base_height;
+//  - mobile particles only, and of them only those inside `region` and
+//    slower than `max_speed` when these are set (a heap on a plate in a
+//    scene with particles elsewhere); height h = z + r - base_height;
 //  - horizontal centre = centroid (x, y) of the particles;
 //  - square xy cells of side cell * d (d = mean diameter), surface height of
 //    a cell = highest particle top in it, at the cell centre's distance r from
@@ -16,6 +18,8 @@
 
 #include "core/particle_store.hpp"
 
+#include <domel/sdk/abi.h>
+
 #include <optional>
 
 namespace domel::platform {
@@ -27,6 +31,8 @@ struct ReposeProbeSettings {
   bool planar = false;                ///< false: a cone about a vertical axis; true: a planar heap
   int axis = 0;                       ///< planar: 0 = x, 1 = y, the direction the heap slopes along
   std::optional<double> crest;        ///< planar: [m] coordinate of the crest line along axis; default: centroid
+  std::optional<domel_region_v1> region;  ///< only particles whose centre is inside; default: all
+  std::optional<double> max_speed;        ///< [m/s] only particles slower than this; default: all
 };
 
 /// The angle in degrees, or nothing when the surface gives no descending fit.

@@ -131,4 +131,33 @@ TEST(ParticleFlow, DeletionRegionAndPlaneCountTheSameMassAndTheBalanceStaysExact
   EXPECT_NEAR(mass_kg(sim->flow.accounts()[0].removed), removed, 1e-12 * removed);
 }
 
+TEST(ParticleFlow, RegionMassCountsTheParticlesInsideItsRegion) {
+  // output.region_mass: a region holding the whole bin counts every particle
+  // present (the balance's inserted - removed, to summation round-off); the
+  // bin's left half counts part of it; a speed limit counts no more.
+  json doc = pour_box(0.08);
+  doc["run"]["duration"] = 0.25;  // the floor is still there: everything poured is in the bin
+  json bin = {{"box", {{"min", {0, 0, 0}}, {"max", {0.04, 0.04, 0.2}}}}};
+  json left = {{"box", {{"min", {0, 0, 0}}, {"max", {0.02, 0.04, 0.2}}}}};
+  doc["output"]["region_mass"] = {{{"name", "bin"}, {"region", bin}},
+                                  {{"name", "left"}, {"region", left}},
+                                  {{"name", "bin_at_rest"}, {"region", bin}, {"max_speed", 0.05}}};
+  auto sim = domel::test::build(doc);
+  domel::platform::RunOptions opt;
+  opt.progress = false;
+  opt.output_directory = ::testing::TempDir() + "/region_mass_test";
+  const json s = sim->run(opt, domel::test::builtin_registry()).summary;
+  const json& bal = s["mass_balance"]["sd"];
+  const double present = bal["inserted_kg"].get<double>() - bal["removed_kg"].get<double>();
+  ASSERT_GT(present, 0.07);
+  const json& rm = s["region_mass"];
+  EXPECT_NEAR(rm["bin"]["mass_kg"].get<double>(), present, 1e-12 * present);
+  EXPECT_EQ(rm["bin"]["particles"].get<std::uint64_t>(), bal["present"].get<std::uint64_t>());
+  const double half = rm["left"]["mass_kg"].get<double>();
+  EXPECT_GT(half, 0.2 * present);
+  EXPECT_LT(half, 0.8 * present);
+  EXPECT_LE(rm["bin_at_rest"]["mass_kg"].get<double>(), rm["bin"]["mass_kg"].get<double>());
+  EXPECT_GT(rm["bin_at_rest"]["particles"].get<std::uint64_t>(), 0u);
+}
+
 }  // namespace

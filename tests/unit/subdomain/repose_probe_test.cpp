@@ -119,3 +119,35 @@ TEST(ReposeProbe, NoHeapNoAngle) {
   for (int k = 0; k < 5; ++k) s.add(k, k * kD, 0, 0.5 * kD, 0.5 * kD, 2500.0);
   EXPECT_FALSE(repose_angle(s, ReposeProbeSettings{}).has_value());  // under 10 particles
 }
+
+TEST(ReposeProbe, RegionAndSpeedLimitSelectTheHeap) {
+  // A cone heap on a plate at the origin, a second heap 0.5 m away (the rest
+  // of a scene) and particles flying fast over the first heap: with a region
+  // around the plate and a speed limit the fit sees the first heap alone.
+  const double theta = 25.0, h = kHeight, e = foot(theta);
+  auto s = stack(-e, e, -e, e, [&](double x, double y) { return h - std::hypot(x, y) * tand(theta); });
+  std::uint64_t id = s.size();
+  for (double x = 0.5 - e; x < 0.5 + e; x += kD)  // a flat layer elsewhere, 6 diameters thick
+    for (double y = -e; y < e; y += kD)
+      for (int k = 0; k < 6; ++k) s.add(id++, x, y, (k + 0.5) * kD, 0.5 * kD, 2500.0);
+  for (int k = 0; k < 40; ++k) {  // a cloud of fast particles above the heap's slope
+    s.add(id, 0.3 * e * std::cos(k), 0.3 * e * std::sin(k), h + (2 + k % 5) * kD, 0.5 * kD, 2500.0);
+    s.vz[s.size() - 1] = 1.0;
+    ++id;
+  }
+  ReposeProbeSettings p;
+  const auto everything = repose_angle(s, p);
+  EXPECT_TRUE(!everything || std::abs(*everything - theta) > 3 * tolerance(theta))
+      << "the unfiltered fit should not find the heap's slope (check that the test's distractors distract)";
+  p.region = domel_region_v1{};
+  p.region->struct_size = sizeof(domel_region_v1);
+  p.region->shape = 2;  // cylinder about z
+  p.region->axis = 2;
+  p.region->radius = e;
+  p.region->lo[2] = 0.0;
+  p.region->hi[2] = 1.0;
+  p.max_speed = 0.05;
+  const auto a = repose_angle(s, p);
+  ASSERT_TRUE(a.has_value());
+  EXPECT_NEAR(*a, theta, tolerance(theta));
+}
