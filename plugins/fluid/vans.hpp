@@ -78,7 +78,8 @@ class Vans {
     "pressure_gradient_force": { "type": "boolean", "default": true, "description": "apply -V grad p to each particle (model A; it holds buoyancy)" },
     "coupling": { "enum": ["two_way", "one_way"], "default": "two_way", "description": "one_way: the fluid ignores the particles (eps = 1, no drag on the fluid)" },
     "void_fraction_min": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.3, "x-unit": "1", "description": "eps is clamped to at least this in the fluid equations and the drag laws" },
-    "substeps": { "type": "integer", "minimum": 1, "default": 1, "description": "fluid steps per coupling interval" },
+    "substeps": { "oneOf": [ { "type": "integer", "minimum": 1 }, { "const": "auto" } ], "default": 1, "description": "fluid steps per coupling interval, or \"auto\": at every exchange the fewest steps (up to max_substeps) that keep the fluid step within its advective (cfl) and viscous limits for the flow as it stands" },
+    "max_substeps": { "type": "integer", "minimum": 1, "default": 16, "description": "with substeps \"auto\": the most fluid steps per coupling interval; the interval is refused (with the limit named) when even these are not enough" },
     "cfl": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5, "x-unit": "1", "description": "advective Courant number limit of a fluid step, sum_a |u_a| dt / dx_a (first-order upwind)" },
     "initial_velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "fluid velocity at the start" },
     "solver": { "type": "object", "default": {}, "properties": {
@@ -160,7 +161,13 @@ class Vans {
     pressure_force_ = j.value("pressure_gradient_force", true);
     two_way_ = j.value("coupling", std::string("two_way")) == "two_way";
     eps_min_ = j.value("void_fraction_min", 0.3);
-    substeps_ = j.value("substeps", 1);
+    if (j.contains("substeps") && j["substeps"].is_string()) {
+      auto_substeps_ = true;
+      substeps_ = 1;
+    } else {
+      substeps_ = j.value("substeps", 1);
+    }
+    max_substeps_ = j.value("max_substeps", 16);
     cfl_ = j.value("cfl", 0.5);
     const nlohmann::json solver = j.value("solver", nlohmann::json::object());
     const double tol = solver.value("tolerance", 1e-8);
@@ -264,6 +271,15 @@ class Vans {
         }
       }
     // 3. the fluid over the interval
+    if (auto_substeps_) {
+      const double need = ex.interval * std::max(advective_rate() / cfl_, viscous_rate());
+      substeps_ = std::clamp(static_cast<int>(std::ceil(need * (1.0 - 1e-12))), 1, max_substeps_);
+      if (substeps_ > substeps_used_max_) {
+        substeps_used_max_ = substeps_;
+        host_.info("substeps auto: " + std::to_string(substeps_) + " fluid steps per coupling interval from exchange " +
+                   std::to_string(exchanges_ + 1) + " on (the most so far)");
+      }
+    }
     const double dt = ex.interval / substeps_;
     for (int s = 0; s < substeps_; ++s) {
       last_solve_ = f.step(dt, static_cast<double>(s) / substeps_, static_cast<double>(s + 1) / substeps_, solve_);
@@ -345,16 +361,24 @@ class Vans {
   // Ferziger & Peric, Computational Methods for Fluid Dynamics, ch. 6); and a
   // choice of domel's: particles move at most half a cell per interval, so
   // that d(eps)/dt in the pressure equation stays resolved.
+  // With substeps "auto" the allowance is max_substeps fluid steps.
+  double advective_rate() const {
+    const MacGrid& g = solver_->grid();
+    const auto umax = solver_->max_speed();
+    double rate = 0;
+    for (int a = 0; a < 3; ++a) rate += umax[a] / g.h[a];
+    return rate;
+  }
+  double viscous_rate() const {
+    const MacGrid& g = solver_->grid();
+    double visc = 0;
+    for (int a = 0; a < 3; ++a) visc += 2.0 / (g.h[a] * g.h[a]);
+    return solver_->settings().mu / solver_->settings().rho * visc;
+  }
   void limits(domel_fluid_limits_v1& out) {
-    const VansSolver& f = *solver_;
-    const MacGrid& g = f.grid();
-    const auto umax = f.max_speed();
-    double rate = 0, visc = 0;
-    for (int a = 0; a < 3; ++a) {
-      rate += umax[a] / g.h[a];
-      visc += 2.0 / (g.h[a] * g.h[a]);
-    }
-    const double nu = f.settings().mu / f.settings().rho;
+    const MacGrid& g = solver_->grid();
+    const double rate = advective_rate(), visc_rate = viscous_rate();
+    const int allowed = auto_substeps_ ? max_substeps_ : substeps_;
     double best = 0;
     const char* why = "";
     auto consider = [&](double lim, const char* what) {
@@ -363,9 +387,10 @@ class Vans {
         why = what;
       }
     };
-    consider(rate > 0 ? substeps_ * cfl_ / rate : 0.0,
-             "advective CFL: sum_a |u_a| dt/dx_a <= cfl per fluid step (substeps x the fluid step)");
-    consider(substeps_ / (nu * visc), "explicit viscous diffusion: nu dt sum_a 2/dx_a^2 <= 1 per fluid step");
+    consider(rate > 0 ? allowed * cfl_ / rate : 0.0,
+             auto_substeps_ ? "advective CFL: sum_a |u_a| dt/dx_a <= cfl per fluid step (max_substeps x the fluid step)"
+                            : "advective CFL: sum_a |u_a| dt/dx_a <= cfl per fluid step (substeps x the fluid step)");
+    consider(allowed / visc_rate, "explicit viscous diffusion: nu dt sum_a 2/dx_a^2 <= 1 per fluid step");
     const double hmin = std::min({g.h[0], g.h[1], g.h[2]});
     consider(vmax_ > 0 ? 0.5 * hmin / vmax_ : 0.0,
              "particles move at most half a cell per coupling interval (the void fraction's rate of change)");
@@ -376,6 +401,8 @@ class Vans {
   }
 
   const VansSolver& solver() const { return *solver_; }
+  /// Fluid steps taken in the last coupling interval.
+  int substeps() const { return substeps_; }
   /// The pressure solve in use: "cg" or "pfmg".
   const std::string& backend() const { return backend_; }
 
@@ -503,6 +530,9 @@ class Vans {
   bool scaling_ = true, pressure_force_ = true, two_way_ = true;
   double eps_min_ = 0.3, cfl_ = 0.5;
   int substeps_ = 1;
+  bool auto_substeps_ = false;
+  int max_substeps_ = 16;
+  int substeps_used_max_ = 1;  ///< substeps "auto": the most fluid steps one interval took
   std::uint64_t exchanges_ = 0;
   SolveReport last_solve_;
   double vmax_ = 0;

@@ -183,3 +183,33 @@ TEST(Vans, AParticleOutsideTheGridIsReportedByIdAndPosition) {
     EXPECT_NE(m.find("is outside the fluid grid; make the grid cover the particles' domain"), std::string::npos) << m;
   }
 }
+
+// substeps "auto": before each interval the coupler takes the fewest fluid
+// steps that keep sum_a |u_a| dt/dx_a within cfl for the flow as it stands,
+// so an interval four times the single step's CFL limit runs (and is not
+// refused: the allowance is max_substeps steps), while a fixed single step
+// reports the CFL limit below the interval.
+TEST(Vans, AutoSubstepsKeepTheFluidStepWithinItsCflLimit) {
+  json fixed = base();
+  fixed["initial_velocity"] = {0, 0, 2.0};
+  json automatic = fixed;
+  automatic["substeps"] = "auto";
+  Vans one{domel::sdk::Params(fixed)}, sub{domel::sdk::Params(automatic)};
+  Particles ps1(50), ps2(50);
+  const double h = 0.01, interval = 4 * 0.5 * h / 2.0;  // cfl 0.5 at 2 m/s across 1 cm cells: 2.5 ms per step
+  domel_fluid_limits_v1 lim{};
+  lim.struct_size = sizeof lim;
+  one.limits(lim);
+  EXPECT_NEAR(lim.max_interval, 0.5 * h / 2.0, 1e-12);
+  sub.limits(lim);
+  EXPECT_NEAR(lim.max_interval, 16 * 0.5 * h / 2.0, 1e-12);
+  for (int s = 0; s < 5; ++s) {
+    const auto u = sub.solver().max_speed();
+    const int expected = static_cast<int>(std::ceil(interval * (u[0] + u[1] + u[2]) / h / 0.5 * (1.0 - 1e-12)));
+    exchange(sub, ps2, s * interval, interval);
+    EXPECT_EQ(sub.substeps(), std::max(1, expected)) << "exchange " << s;
+    if (s == 0) EXPECT_EQ(sub.substeps(), 4);  // the initial 2 m/s; the inlet's 0.5 m/s then slows the flow
+  }
+  EXPECT_LT(sub.solver().continuity_residual(interval / sub.substeps()), 1e-6);
+}
+
