@@ -69,6 +69,72 @@ std::string slug(const std::string& s) {
   return out;
 }
 
+std::filesystem::path write_report(const std::filesystem::path& out, const std::string& title, const std::string& intro,
+                                   const std::string& what, const std::vector<std::string>& labels,
+                                   const std::vector<std::string>& rows, const std::vector<std::filesystem::path>& dirs,
+                                   const std::vector<json>& summaries) {
+  // Plots (python3 + matplotlib); the report is written without them otherwise.
+  std::vector<std::string> pngs;
+  {
+    const auto script = out / "plot_compare.py";
+    io::write_file_atomically(script, kPlotCompareScript);
+    // Debian's interpreter first: python3-matplotlib installs into it, while a
+    // python3 earlier on PATH (pyenv, venv) may lack matplotlib.
+    const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    std::string cmd = python + " " + shell_quote(script.string()) + " " + shell_quote(out.string());
+    for (std::size_t k = 0; k < dirs.size(); ++k)
+      cmd += " " + shell_quote(labels[k]) + " " + shell_quote(dirs[k].string());
+    cmd += " 2>&1";
+    if (FILE* p = popen(cmd.c_str(), "r")) {
+      char line[512];
+      std::string all;
+      while (std::fgets(line, sizeof line, p)) all += line;
+      const int rc = pclose(p);
+      if (rc == 0) {
+        std::stringstream ss(all);
+        std::string l;
+        while (std::getline(ss, l))
+          if (l.size() > 4 && l.substr(l.size() - 4) == ".png") pngs.push_back(l);
+      } else {
+        spdlog::warn("compare: plots not made (python3 with matplotlib needed): {}", all);
+      }
+    }
+  }
+
+  std::ostringstream md;
+  md << "# " << title << "\n\n" << intro << "\n\n";
+  md << "| variant | " << what << " |\n|---|---|\n";
+  for (std::size_t k = 0; k < labels.size(); ++k) md << "| " << labels[k] << " | " << rows[k] << " |\n";
+  md << "\n## Final values\n\n";
+  // one row per observable column (from the last probe row), one column per variant
+  std::vector<std::vector<std::pair<std::string, double>>> finals;
+  for (const auto& d : dirs) finals.push_back(last_row(d / "probes.csv"));
+  md << "| quantity |";
+  for (const auto& l : labels) md << " " << l << " |";
+  md << "\n|---|";
+  for (std::size_t k = 0; k < dirs.size(); ++k) md << "---|";
+  md << "\n";
+  if (!finals.empty())
+    for (std::size_t c = 0; c < finals[0].size(); ++c) {
+      md << "| " << finals[0][c].first << " |";
+      for (const auto& f : finals) md << " " << (c < f.size() ? fmt(f[c].second) : "–") << " |";
+      md << "\n";
+    }
+  md << "| wall time [s] |";
+  for (const auto& s : summaries) md << " " << fmt(s.value("wall_time_s", 0.0)) << " |";
+  md << "\n| particle-steps/s |";
+  for (const auto& s : summaries) md << " " << fmt(s.value("particle_steps_per_s", 0.0)) << " |";
+  md << "\n\n";
+  if (!pngs.empty()) {
+    md << "## Time series\n\n";
+    for (const auto& p : pngs) md << "![" << p << "](" << p << ")\n\n";
+  }
+  md << "Each variant's own output (ParaView files, probes.csv, summary.json) is in the folder named after it.\n";
+  const auto report = out / "report.md";
+  io::write_file_atomically(report, md.str());
+  return report;
+}
+
 }  // namespace
 
 CompareVariant parse_variant(const std::string& text, const std::string& label) {
@@ -153,72 +219,54 @@ std::filesystem::path run_compare(const CompareOptions& options, PluginRegistry&
     summaries.push_back(r.summary);
   }
 
-  // Plots (python3 + matplotlib); the report is written without them otherwise.
-  std::vector<std::string> pngs;
-  {
-    const auto script = out / "plot_compare.py";
-    io::write_file_atomically(script, kPlotCompareScript);
-    // Debian's interpreter first: python3-matplotlib installs into it, while a
-    // python3 earlier on PATH (pyenv, venv) may lack matplotlib.
-    const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    std::string cmd = python + " " + shell_quote(script.string()) + " " + shell_quote(out.string());
-    for (std::size_t k = 0; k < dirs.size(); ++k)
-      cmd += " " + shell_quote(options.variants[k].label) + " " + shell_quote(dirs[k].string());
-    cmd += " 2>&1";
-    if (FILE* p = popen(cmd.c_str(), "r")) {
-      char line[512];
-      std::string all;
-      while (std::fgets(line, sizeof line, p)) all += line;
-      const int rc = pclose(p);
-      if (rc == 0) {
-        std::stringstream ss(all);
-        std::string l;
-        while (std::getline(ss, l))
-          if (l.size() > 4 && l.substr(l.size() - 4) == ".png") pngs.push_back(l);
-      } else {
-        spdlog::warn("compare: plots not made (python3 with matplotlib needed): {}", all);
-      }
-    }
-  }
-
-  std::ostringstream md;
-  md << "# A/B comparison: " << options.scenario.filename().string() << "\n\n";
-  md << "Scenario `" << options.scenario.string() << "`, " << sims.size()
-     << " variants, identical seeds and insertion; written by `domel compare` (domel " << DOMEL_VERSION << ").\n\n";
-  md << "| variant | overrides |\n|---|---|\n";
+  std::vector<std::string> labels, rows;
   for (const auto& v : options.variants) {
     std::string o;
     for (const auto& [p, val] : v.assignments) o += (o.empty() ? "" : "<br>") + ("`" + p + "` = `" + val + "`");
-    md << "| " << v.label << " | " << o << " |\n";
+    labels.push_back(v.label);
+    rows.push_back(o);
   }
-  md << "\n## Final values\n\n";
-  // one row per observable column (from the last probe row), one column per variant
-  std::vector<std::vector<std::pair<std::string, double>>> finals;
-  for (const auto& d : dirs) finals.push_back(last_row(d / "probes.csv"));
-  md << "| quantity |";
-  for (const auto& v : options.variants) md << " " << v.label << " |";
-  md << "\n|---|";
-  for (std::size_t k = 0; k < dirs.size(); ++k) md << "---|";
-  md << "\n";
-  if (!finals.empty())
-    for (std::size_t c = 0; c < finals[0].size(); ++c) {
-      md << "| " << finals[0][c].first << " |";
-      for (const auto& f : finals) md << " " << (c < f.size() ? fmt(f[c].second) : "–") << " |";
-      md << "\n";
+  const std::string intro = "Scenario `" + options.scenario.string() + "`, " + std::to_string(sims.size()) +
+                            " variants, identical seeds and insertion; written by `domel compare` (domel " +
+                            DOMEL_VERSION + ").";
+  return write_report(out, "A/B comparison: " + options.scenario.filename().string(), intro, "overrides", labels, rows,
+                      dirs, summaries);
+}
+
+std::filesystem::path report_runs(const std::filesystem::path& out, const std::vector<std::filesystem::path>& runs,
+                                  std::vector<std::string> labels) {
+  std::vector<Diagnostic> diags;
+  std::vector<json> summaries;
+  std::vector<std::string> rows;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const auto sj = runs[k] / "summary.json", pc = runs[k] / "probes.csv";
+    if (!std::filesystem::exists(sj) || !std::filesystem::exists(pc)) {
+      diags.push_back({runs[k].string(), "",
+                       "--runs " + runs[k].string() +
+                           ": expected the output folder of a finished run, with summary.json and probes.csv; found " +
+                           std::string(std::filesystem::exists(runs[k]) ? "a folder without them" : "no such folder"),
+                       "a run that failed or was stopped writes no summary.json"});
+      continue;
     }
-  md << "| wall time [s] |";
-  for (const auto& s : summaries) md << " " << fmt(s.value("wall_time_s", 0.0)) << " |";
-  md << "\n| particle-steps/s |";
-  for (const auto& s : summaries) md << " " << fmt(s.value("particle_steps_per_s", 0.0)) << " |";
-  md << "\n\n";
-  if (!pngs.empty()) {
-    md << "## Time series\n\n";
-    for (const auto& p : pngs) md << "![" << p << "](" << p << ")\n\n";
+    json s;
+    try {
+      s = read_json(sj);
+    } catch (const json::exception& e) {
+      diags.push_back({sj.string(), "", sj.string() + " is not valid JSON: " + e.what(), ""});
+      continue;
+    }
+    const json sc = s.value("scenario", json::object());
+    rows.push_back("`" + sc.value("file", std::string("?")) + "`, folder `" + runs[k].string() + "`");
+    summaries.push_back(s);
   }
-  md << "Each variant's own output (ParaView files, probes.csv, summary.json) is in the folder named after it.\n";
-  const auto report = out / "report.md";
-  io::write_file_atomically(report, md.str());
-  return report;
+  if (!diags.empty()) throw ConfigError(diags);
+  if (labels.empty())
+    for (const auto& r : runs) labels.push_back(r.filename().empty() ? r.parent_path().filename().string() : r.filename().string());
+  std::filesystem::create_directories(out);
+  const std::string intro = std::to_string(runs.size()) + " finished runs, compared by `domel compare --runs` (domel " +
+                            std::string(DOMEL_VERSION) + "); each row names its scenario file and output folder.";
+  return write_report(out, "Comparison of " + std::to_string(runs.size()) + " runs", intro, "run", labels, rows, runs,
+                      summaries);
 }
 
 }  // namespace domel::platform

@@ -41,6 +41,9 @@ commands:
                       run variants of one scenario (same seeds and insertion) and write
                       DIR/report.md with a table of final values and PNG plots, e.g.
                       --vary '/subdomains/0/contact/rolling={"model":"dct","rolling_friction":0.1}'
+  compare --runs DIR --runs DIR [--runs ...] [--label NAME ...] [--out DIR]
+                      the same report of finished runs (their output folders), made
+                      by any scenarios, e.g. runs made side by side on several cores
   validate FILE...    check scenarios without running them; lists every problem
   plugins [--json]    list loaded plugin models with versions, ABI and parameters
   schema [--out FILE] print the complete scenario JSON Schema (for editors, via "$schema")
@@ -179,13 +182,13 @@ int cmd_compare(int argc, char** argv) {
   check_thread_environment();
   // --vary and --label repeat, so they are collected here rather than by parse()
   dp::CompareOptions opt;
-  std::vector<std::string> varies, labels;
+  std::vector<std::string> varies, labels, runs;
   std::vector<std::string> rest_args;
   for (int k = 2; k < argc; ++k) {
     const std::string s = argv[k];
-    if ((s == "--vary" || s == "--label") && k + 1 < argc) {
-      (s == "--vary" ? varies : labels).push_back(argv[++k]);
-    } else if (s == "--vary" || s == "--label") {
+    if ((s == "--vary" || s == "--label" || s == "--runs") && k + 1 < argc) {
+      (s == "--vary" ? varies : s == "--label" ? labels : runs).push_back(argv[++k]);
+    } else if (s == "--vary" || s == "--label" || s == "--runs") {
       throw UsageError("option " + s + " needs a value");
     } else {
       rest_args.push_back(s);
@@ -194,6 +197,26 @@ int cmd_compare(int argc, char** argv) {
   std::vector<char*> rest = {argv[0], argv[1]};
   for (auto& s : rest_args) rest.push_back(s.data());
   const Args a = parse(static_cast<int>(rest.size()), rest.data(), 2, {"--out", "--threads", "--max-steps"}, {"--quiet"});
+  if (!runs.empty()) {
+    // the report of finished runs: nothing is run
+    if (!a.positional.empty() || !varies.empty())
+      throw UsageError("compare --runs takes output folders of finished runs, not a scenario or --vary");
+    if (runs.size() < 2) throw UsageError("compare --runs needs at least two run folders");
+    if (!labels.empty() && labels.size() != runs.size()) throw UsageError("give one --label per --runs (or none)");
+    if (a.option("--threads") || a.option("--max-steps"))
+      throw UsageError("--threads and --max-steps are for runs; compare --runs runs nothing");
+    const std::filesystem::path out = a.option("--out").value_or("runs_compare");
+    std::vector<std::filesystem::path> dirs(runs.begin(), runs.end());
+    try {
+      const auto report = dp::report_runs(out, dirs, labels);
+      std::printf("report: %s\n", report.string().c_str());
+    } catch (const dp::ConfigError& e) {
+      print_diagnostics("compare --runs", e.diagnostics());
+      std::fprintf(stderr, "no report was written.\n");
+      return kExitRefused;
+    }
+    return 0;
+  }
   if (a.positional.size() != 1) throw UsageError("compare expects one scenario file");
   if (varies.size() < 2) throw UsageError("compare needs at least two --vary variants");
   if (!labels.empty() && labels.size() != varies.size())

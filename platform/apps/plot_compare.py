@@ -19,6 +19,11 @@ PLOTS = [  # (column suffix, title, y label, log scale)
     ("ke_rotational", "Rotational kinetic energy", "E_rot [J]", True),
     ("repose_angle_deg", "Angle of repose (free-surface fit)", "angle [deg]", False),
 ]
+# One PNG per column name: NAME.SUFFIX.png (output.region_mass, deletion regions).
+PER_COLUMN = [  # (column suffix, title, y label)
+    ("mass_kg", "Mass in region (or crossed plane) {name}", "mass [kg]"),
+    ("removed_kg", "Mass removed by {name}", "mass [kg]"),
+]
 
 
 def read(path):
@@ -64,6 +69,31 @@ def main():
         fig.savefig(os.path.join(out, name), dpi=110)
         plt.close(fig)
         written.append(name)
+    names = sorted({c for rows in data.values() for c in (rows[0].keys() if rows else [])})
+    for suffix, title, ylabel in PER_COLUMN:
+        for col in [c for c in names if c.endswith("." + suffix)]:
+            fig, ax = plt.subplots(figsize=(7, 4.2))
+            drawn = False
+            for label, rows in data.items():
+                if not rows or col not in rows[0]:
+                    continue
+                pts = [(float(r["time"]), float(r[col])) for r in rows if math.isfinite(float(r[col]))]
+                if pts:
+                    ax.plot([p[0] for p in pts], [p[1] for p in pts], label=label, linewidth=1.4)
+                    drawn = True
+            if not drawn:
+                plt.close(fig)
+                continue
+            ax.set_xlabel("simulated time [s]")
+            ax.set_ylabel(ylabel)
+            ax.set_title(title.format(name=col[: -len(suffix) - 1]))
+            ax.grid(True, alpha=0.3)
+            ax.legend()
+            fig.tight_layout()
+            name = f"{col}.png"
+            fig.savefig(os.path.join(out, name), dpi=110)
+            plt.close(fig)
+            written.append(name)
     print("\n".join(written))
 
 

@@ -335,3 +335,32 @@ TEST_F(Cli, CompareRefusesABadVariantBeforeRunning) {
   EXPECT_NE(r.err.find("variant"), std::string::npos) << show(r);
   EXPECT_FALSE(fs::exists(out)) << "nothing may be written when a variant is refused";
 }
+
+// Guards `domel compare --runs`: the report of runs made before (here two
+// short runs of settle.json) has the same table, one column per run, and
+// names each run's folder; a folder that holds no finished run is refused,
+// naming it, and no report is written.
+TEST_F(Cli, CompareReportsFinishedRunsAndRefusesAFolderWithoutOne) {
+  for (const char* v : {"a", "b"}) {
+    const Result run = domel({"run", kSettle.string(), "--out", (tmp_ / v).string(), "--max-steps",
+                              std::string(v) == "a" ? "30" : "60", "--quiet"});
+    ASSERT_EQ(run.exit_code, 0) << show(run);
+  }
+  const fs::path out = tmp_ / "cmp_runs";
+  const Result r = domel({"compare", "--runs", (tmp_ / "a").string(), "--runs", (tmp_ / "b").string(), "--label",
+                          "short", "--label", "long", "--out", out.string()});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+  const std::string report = read_file(out / "report.md");
+  EXPECT_NE(report.find("| quantity | short | long |"), std::string::npos) << report;
+  EXPECT_NE(report.find((tmp_ / "b").string()), std::string::npos) << report;
+  EXPECT_NE(report.find("column.median_angular_speed"), std::string::npos) << report;
+
+  fs::create_directories(tmp_ / "empty");
+  const fs::path out2 = tmp_ / "cmp_runs_bad";
+  const Result bad = domel({"compare", "--runs", (tmp_ / "a").string(), "--runs", (tmp_ / "empty").string(), "--out",
+                            out2.string()});
+  EXPECT_EQ(bad.exit_code, 2) << show(bad);
+  EXPECT_NE(bad.err.find((tmp_ / "empty").string()), std::string::npos) << show(bad);
+  EXPECT_NE(bad.err.find("summary.json"), std::string::npos) << show(bad);
+  EXPECT_FALSE(fs::exists(out2 / "report.md"));
+}
