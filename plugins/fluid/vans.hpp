@@ -436,13 +436,79 @@ class Vans {
     return v;
   }
 
+  /// The gas velocity u_a at x: trilinear on the face grid of axis a, with
+  /// the walls' ghost values the momentum equation uses. Beyond a side of the
+  /// box the tangential velocity takes the side's ghost (a no-slip wall
+  /// mirrors it, so it vanishes on the wall; a slip wall and an outlet copy
+  /// it; an inlet sets it), and a face inside an obstacle mirrors its fluid
+  /// neighbours. So a particle resting on a wall or on a plate feels the gas
+  /// as it is at its centre's height above the surface, not at the height of
+  /// the nearest cell centre (half a cell or more higher).
+  double gas_velocity(int a, const double x[3]) const {
+    const VansSolver& f = *solver_;
+    const MacGrid& g = f.grid();
+    const std::vector<double>& u = f.u(a);
+    int i0[3];
+    double t[3];
+    for (int d = 0; d < 3; ++d) {
+      const int count = g.fn(a, d);
+      const double off = d == a ? 0.0 : 0.5;
+      // along a: the faces span the box; across: ghosts half a cell beyond it
+      const double s = std::clamp((x[d] - g.lo[d]) / g.h[d] - off, d == a ? 0.0 : -0.5,
+                                  d == a ? count - 1.0 : count - 0.5);
+      int i = static_cast<int>(std::floor(s));
+      if (d == a && i >= count - 1) i = count - 2;
+      i0[d] = i;
+      t[d] = s - i;
+    }
+    // value at node n, whose tangential indices may lie one beyond the box
+    auto node_value = [&](const int n[3]) {
+      int m[3] = {n[0], n[1], n[2]};
+      double sign = 1, add = 0;  // the value is sign * u[m] + add
+      for (int d = 0; d < 3; ++d) {
+        if (d == a || (m[d] >= 0 && m[d] < g.fn(a, d))) continue;
+        const Boundary& b = f.settings().sides[2 * d + (m[d] < 0 ? 0 : 1)];
+        m[d] = m[d] < 0 ? 0 : g.fn(a, d) - 1;
+        if (b.type == Boundary::wall) {
+          sign = -sign, add = -add;
+        } else if (b.type == Boundary::velocity_inlet) {
+          sign = -sign, add = 2 * b.velocity[a] - add;
+        }
+      }
+      return std::pair<double, bool>{sign * u[g.face(a, m[0], m[1], m[2])] + add, f.solid_face(a, m[0], m[1], m[2])};
+    };
+    double v = 0;
+    for (int q = 0; q < 8; ++q) {
+      const int bit[3] = {q & 1, (q >> 1) & 1, (q >> 2) & 1};
+      const int n[3] = {i0[0] + bit[0], i0[1] + bit[1], i0[2] + bit[2]};
+      double w = 1;
+      for (int d = 0; d < 3; ++d) w *= bit[d] ? t[d] : 1 - t[d];
+      if (w == 0) continue;
+      auto [val, solid] = node_value(n);
+      if (solid) {  // mirror of the fluid partners across the obstacle's face
+        double sum = 0;
+        int cnt = 0;
+        for (int d = 0; d < 3; ++d) {
+          if (d == a) continue;
+          int p[3] = {n[0], n[1], n[2]};
+          p[d] += bit[d] ? -1 : 1;
+          const auto [pv, psolid] = node_value(p);
+          if (!psolid) sum -= pv, ++cnt;
+        }
+        val = cnt ? sum / cnt : 0.0;
+      }
+      v += w * val;
+    }
+    return v;
+  }
+
   /// beta of a particle (a parcel: coarse-grain scaled) with the fluid's
   /// velocity and void fraction at its centre; the velocity into uf if given.
   double particle_beta(const double x[3], const double v[3], double r, double alpha, double* uf,
                        Validity* val = nullptr) const {
     const VansSolver& f = *solver_;
     double u[3];
-    for (int a = 0; a < 3; ++a) u[a] = interpolate(a, x, f.u(a));
+    for (int a = 0; a < 3; ++a) u[a] = gas_velocity(a, x);
     const double e = std::clamp(interpolate(-1, x, f.eps()), eps_min_, 1.0);
     const double slip = std::sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
                                   (u[2] - v[2]) * (u[2] - v[2]));

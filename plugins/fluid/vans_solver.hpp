@@ -31,8 +31,10 @@
 // it (the rest of the side is wall; the velocity given is superficial, so
 // eps u = U across the face even where particles sit on it), pressure outlet (p fixed half a cell
 // outside the last cell centre, zero gradient of the velocity). Blocked cells
-// (obstacles) are walls on every face. At least one outlet is required: it
-// fixes the pressure level, so the system is non-singular.
+// (obstacles) are no-slip walls on every face: the tangential velocity inside
+// an obstacle is the mirror of the flow's, as beyond a wall side of the box.
+// At least one outlet is required: it fixes the pressure level, so the
+// system is non-singular.
 #pragma once
 
 #include "plugins/fluid/mac_grid.hpp"
@@ -378,6 +380,21 @@ class VansSolver {
         for (int i = 0; i < g.fn(a, 0); ++i) fn(i, j, k, g.face(a, i, j, k));
   }
 
+  /// Face (i, j, k) of axis a lies inside an obstacle: the cells on both of
+  /// its sides are blocked (or one is blocked and the other beyond the box).
+  /// Its u_a is not a flow value; a tangential neighbour mirrors it instead.
+  bool solid_face(int a, int i, int j, int k) const {
+    const MacGrid& g = s_.grid;
+    const int idx[3] = {i, j, k};
+    int l[3] = {i, j, k};
+    l[a] -= 1;
+    const bool hi_solid = idx[a] == g.n[a] || blocked_[g.cell(i, j, k)] != 0;
+    const bool lo_solid = idx[a] == 0 || blocked_[g.cell(l[0], l[1], l[2])] != 0;
+    const bool any_blocked = (idx[a] < g.n[a] && blocked_[g.cell(i, j, k)] != 0) ||
+                             (idx[a] > 0 && blocked_[g.cell(l[0], l[1], l[2])] != 0);
+    return hi_solid && lo_solid && any_blocked;
+  }
+
   /// Void fraction on face (i, j, k) of axis a: the mean of the cells on its
   /// two sides, the inner cell's on the boundary.
   double face_eps(const std::vector<double>& e, int a, int i, int j, int k) const {
@@ -467,7 +484,12 @@ class VansSolver {
     int q[3] = {i, j, k};
     q[b] += dir;
     const double here = u_[a][g.face(a, i, j, k)];
-    if (q[b] >= 0 && q[b] < g.fn(a, b)) return u_[a][g.face(a, q[0], q[1], q[2])];
+    if (q[b] >= 0 && q[b] < g.fn(a, b)) {
+      // a tangential face inside an obstacle: mirrored, so the no-slip wall
+      // lies on the obstacle's face, half a cell from either node
+      if (b != a && solid_face(a, q[0], q[1], q[2])) return -here;
+      return u_[a][g.face(a, q[0], q[1], q[2])];
+    }
     if (b == a) return here;  // beyond the last normal face: zero gradient
     const Boundary& bd = s_.sides[2 * b + (dir > 0 ? 1 : 0)];
     switch (bd.type) {
