@@ -32,6 +32,21 @@ def read(path):
     return rows
 
 
+def save(fig, ax, out, name, title, ylabel, log):
+    """Labels, legend and PNG of one plot; returns the file name."""
+    if log:
+        ax.set_yscale("log")
+    ax.set_xlabel("simulated time [s]")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, name), dpi=110)
+    plt.close(fig)
+    return name
+
+
 def main():
     out = sys.argv[1]
     args = sys.argv[2:]
@@ -57,18 +72,7 @@ def main():
         if not drawn:
             plt.close(fig)
             continue
-        if log:
-            ax.set_yscale("log")
-        ax.set_xlabel("simulated time [s]")
-        ax.set_ylabel(ylabel)
-        ax.set_title(title)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        name = f"{suffix}.png"
-        fig.savefig(os.path.join(out, name), dpi=110)
-        plt.close(fig)
-        written.append(name)
+        written.append(save(fig, ax, out, f"{suffix}.png", title, ylabel, log))
     names = sorted({c for rows in data.values() for c in (rows[0].keys() if rows else [])})
     for suffix, title, ylabel in PER_COLUMN:
         for col in [c for c in names if c.endswith("." + suffix)]:
@@ -84,16 +88,7 @@ def main():
             if not drawn:
                 plt.close(fig)
                 continue
-            ax.set_xlabel("simulated time [s]")
-            ax.set_ylabel(ylabel)
-            ax.set_title(title.format(name=col[: -len(suffix) - 1]))
-            ax.grid(True, alpha=0.3)
-            ax.legend()
-            fig.tight_layout()
-            name = f"{col}.png"
-            fig.savefig(os.path.join(out, name), dpi=110)
-            plt.close(fig)
-            written.append(name)
+            written.append(save(fig, ax, out, f"{col}.png", title.format(name=col[: -len(suffix) - 1]), ylabel, False))
     print("\n".join(written))
 
 
