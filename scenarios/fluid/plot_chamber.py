@@ -1,0 +1,122 @@
+#!/usr/bin/env python3
+"""Pictures and a table for the DEM-CFD chamber runs (docs/validation/chamber.md).
+
+  plot_chamber.py fields RUN_DIR TIME OUT.png   the gas speed on the chamber's
+      mid-plane (y = 20 mm) with its in-plane velocity as arrows and the
+      particles within one fluid cell of that plane, over the whole chamber
+      and zoomed on the plate
+  plot_chamber.py table LABEL=RUN_DIR ...       one Markdown row per run: the
+      mass at rest on the plate at the end and averaged over the last 0.2 s,
+      its particles, the mass carried out at the top, the largest overlap
+      seen, the angle of repose (when a heap can be fitted), the wall time
+      and the fluid coupler's share of it (issue 16 item 6)
+
+Reads only domel's own files (fluid_*.vti, particles_*.vtp, *.pvd,
+probes.csv, summary.json) with vti.py, without the VTK Python package."""
+import csv
+import json
+import math
+import os
+import re
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from vti import read_vti, read_vtp  # noqa: E402
+
+PLATE_Z, PLATE_R, SIDE = 0.140, 0.0115, 0.04
+
+
+def frame_at(run, series, t):
+    """The file of a .pvd series whose time is nearest to t."""
+    text = open(os.path.join(run, series + ".pvd")).read()
+    frames = [(float(m.group(1)), m.group(2)) for m in re.finditer(r'timestep="([^"]+)"[^>]*file="([^"]+)"', text)]
+    ts, f = min(frames, key=lambda x: abs(x[0] - t))
+    return ts, os.path.join(run, f)
+
+
+def fields(run, t, out):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    tf, vti = frame_at(run, "fluid", t)
+    tp, vtp = frame_at(run, "particles", t)
+    (nx, ny, nz), origin, h, a = read_vti(vti)
+    u, blocked = a["velocity"], a["blocked"]
+    j0, j1 = ny // 2 - 1, ny // 2  # the two cell rows either side of y = 20 mm
+    speed = [[0.0] * nx for _ in range(nz)]
+    ux = [[0.0] * nx for _ in range(nz)]
+    uz = [[0.0] * nx for _ in range(nz)]
+    for k in range(nz):
+        for i in range(nx):
+            c0, c1 = i + nx * (j0 + ny * k), i + nx * (j1 + ny * k)
+            if blocked[c0] > 0.5 and blocked[c1] > 0.5:
+                speed[k][i] = float("nan")
+                continue
+            vx, vz = 0.5 * (u[c0][0] + u[c1][0]), 0.5 * (u[c0][2] + u[c1][2])
+            ux[k][i], uz[k][i] = vx, vz
+            speed[k][i] = math.hypot(vx, vz)
+    p = read_vtp(vtp)
+    px, pz = [], []
+    for (x, y, z) in p["Points"]:
+        if abs(y - SIDE / 2) < h[1]:
+            px.append(x * 1e3)
+            pz.append(z * 1e3)
+    ext = [origin[0] * 1e3, (origin[0] + nx * h[0]) * 1e3, origin[2] * 1e3, (origin[2] + nz * h[2]) * 1e3]
+    fig, axes = plt.subplots(1, 2, figsize=(9, 7.5), gridspec_kw={"width_ratios": [1, 1.6]})
+    for ax, zoom in zip(axes, (False, True)):
+        im = ax.imshow(speed, origin="lower", extent=ext, cmap="viridis", vmin=0, vmax=3.0, aspect="equal")
+        xs = [(origin[0] + (i + 0.5) * h[0]) * 1e3 for i in range(nx)]
+        zs = [(origin[2] + (k + 0.5) * h[2]) * 1e3 for k in range(nz)]
+        step = 1 if zoom else 2
+        kk = [k for k in range(0, nz, step) if not zoom or 120 <= zs[k] <= 180]
+        ax.quiver([xs[i] for k in kk for i in range(0, nx, step)], [zs[k] for k in kk for i in range(0, nx, step)],
+                  [ux[k][i] for k in kk for i in range(0, nx, step)], [uz[k][i] for k in kk for i in range(0, nx, step)],
+                  color="white", scale=40 if zoom else 60, width=0.004)
+        ax.scatter(px, pz, s=2 if not zoom else 6, c="tab:red", linewidths=0)
+        ax.plot([(SIDE / 2 - PLATE_R) * 1e3, (SIDE / 2 + PLATE_R) * 1e3], [PLATE_Z * 1e3] * 2, color="k", lw=2.5)
+        ax.set_xlabel("x [mm]")
+        if zoom:
+            ax.set_ylim(120, 180)
+            ax.set_title("near the plate")
+        else:
+            ax.set_ylabel("z [mm]")
+            ax.set_title("whole chamber")
+    fig.colorbar(im, ax=axes, label="gas speed in the plane [m/s]", shrink=0.8)
+    fig.suptitle(f"{os.path.basename(os.path.normpath(run))}: mid-plane y = 20 mm, gas at t = {tf:.2f} s, "
+                 f"particles within {h[1] * 1e3:.1f} mm of the plane at t = {tp:.2f} s", fontsize=9)
+    fig.savefig(out, dpi=110)
+    print(out)
+
+
+def table(pairs):
+    print("| run | on the plate at rest, end [mg] | mean over the last 0.2 s [mg] | parcels | out at the top [g] "
+          "| largest overlap / R | angle [deg] | wall time [s] | fluid coupler: ms per exchange, share |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for pair in pairs:
+        label, run = pair.split("=", 1)
+        rows = list(csv.DictReader(open(os.path.join(run, "probes.csv"))))
+        s = json.load(open(os.path.join(run, "summary.json")))
+        t_end = float(rows[-1]["time"])
+        last = [r for r in rows if float(r["time"]) >= t_end - 0.2 - 1e-9]
+        mean = sum(float(r["plate_heap.mass_kg"]) for r in last) / len(last)
+        overlap = max(float(r["beads.max_overlap_ratio"]) for r in rows)
+        angle = s.get("repose_angle_deg", {}).get("beads")
+        fl = s["fluid"]
+        out = rows[-1].get("top_outlet.removed_kg", "nan")
+        print(f"| {label} | {float(rows[-1]['plate_heap.mass_kg']) * 1e6:.1f} | {mean * 1e6:.1f} "
+              f"| {rows[-1]['plate_heap.particles']} | {float(out) * 1e3:.3f} | {overlap:.3f} "
+              f"| {'–' if angle is None else f'{angle:.1f}'} | {s['wall_time_s']:.0f} "
+              f"| {fl['coupler_seconds_per_exchange'] * 1e3:.1f}, {fl['coupler_seconds'] / s['wall_time_s']:.0%} |")
+
+
+def main():
+    if len(sys.argv) >= 5 and sys.argv[1] == "fields":
+        fields(sys.argv[2], float(sys.argv[3]), sys.argv[4])
+    elif len(sys.argv) >= 3 and sys.argv[1] == "table":
+        table(sys.argv[2:])
+    else:
+        sys.exit(__doc__)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Runs the DEM-CFD chamber cases (docs/validation/chamber.md) side by side,
+# JOBS at a time with one thread each, then writes one `domel compare`
+# report over all of them, the table and the pictures.
+#   scenarios/fluid/run_chamber.sh OUTDIR [JOBS]        (JOBS: default nproc)
+# Runs already finished in OUTDIR (a summary.json) are kept, not redone.
+# About 35 minutes on 2 cores (the two alpha = 4 runs take 13-14 minutes each).
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+out="${1:?usage: run_chamber.sh OUTDIR [JOBS]}"
+jobs="${2:-$(nproc)}"
+domel="${DOMEL:-$root/build/bin/domel}"
+python="/usr/bin/python3"
+[ -x "$python" ] || python=python3
+mkdir -p "$out"
+runs=(a4_none a4_sd a6_none a6_sd a8_none a8_sd bottom_a4 bottom_a4_unscaled bottom_a8 spout_a8_none spout_a8_sd)
+for r in "${runs[@]}"; do
+  [ -f "$out/$r/summary.json" ] && continue
+  echo "$r"
+done | xargs -r -P "$jobs" -I{} sh -c '"$0" run "$1" --out "$2/{}" --threads 1 --quiet > "$2/{}.log" 2>&1 && echo "done: {}" || { echo "FAILED: {} (see $2/{}.log)"; exit 1; }' \
+  "$domel" "$here/chamber_{}.json" "$out"
+args=()
+for r in "${runs[@]}"; do args+=(--runs "$out/$r" --label "$r"); done
+"$domel" compare "${args[@]}" --out "$out/report"
+pairs=()
+for r in "${runs[@]}"; do pairs+=("$r=$out/$r"); done
+"$python" "$here/plot_chamber.py" table "${pairs[@]}" > "$out/report/table.md"
+for r in a4_none a4_sd a8_sd; do
+  "$python" "$here/plot_chamber.py" fields "$out/$r" 0.8 "$out/report/fields_${r}_0.8s.png"
+  "$python" "$here/plot_chamber.py" fields "$out/$r" 2.0 "$out/report/fields_${r}_2.0s.png"
+done
+echo "report: $out/report/report.md, table: $out/report/table.md"
