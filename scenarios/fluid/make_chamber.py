@@ -4,7 +4,7 @@ docs/validation/chamber.md gives every choice and its reason):
 
   chamber_a{4,6,8}_none.json  fed into the plate's wake; no rolling resistance
   chamber_a{4,6,8}_sd.json    the same with sd_critical_angle, theta_c = THETA_C
-  chamber_bottom_a{4,8}.json  fed near the floor instead, for 0.5 s: do the
+  chamber_bottom_a{4,8}.json  fed near the floor instead, for 0.3 s: do the
                               beads rise past the plate, and do any settle on it?
   chamber_bottom_a4_unscaled.json  the same at alpha = 4 with the drag evaluated
                               at the parcel's own diameter (coarse-grain scaling off)
@@ -54,7 +54,7 @@ def scenario(alpha, rolling, scaling=True, feed="wake"):
     else:
         name = f"chamber_bottom_a{alpha}" + ("" if scaling else "_unscaled")
         region = {"box": {"min": [0.001, 0.001, 0.005], "max": [SIDE - 0.001, SIDE - 0.001, 0.025]}}
-        velocity, fraction, duration = [0, 0, 0.9], 0.005, 0.5
+        velocity, fraction, duration = [0, 0, 0.9], 0.005, 0.3
     # the heap's region: over the plate up to 10 mm (a heap at 30 deg is 6.6 mm
     # tall), below the feed
     heap = {"cylinder": {"axis": "z", "center": [SIDE / 2, SIDE / 2, 0], "radius": PLATE_R + 0.001,

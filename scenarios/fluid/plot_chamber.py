@@ -5,6 +5,9 @@
       mid-plane (y = 20 mm) with its in-plane velocity as arrows and the
       particles within one fluid cell of that plane, over the whole chamber
       and zoomed on the plate
+  plot_chamber.py profile OUT.png LABEL=RUN_DIR ...   the heap's surface on the
+      plate at the end of each run: the highest particle top over the plate
+      in rings of half a parcel diameter, against the distance from the axis
   plot_chamber.py table LABEL=RUN_DIR ...       one Markdown row per run: the
       mass at rest on the plate at the end and averaged over the last 0.2 s,
       its particles, the mass carried out at the top, the largest overlap
@@ -88,6 +91,41 @@ def fields(run, t, out):
     print(out)
 
 
+def profile(out, pairs):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for pair in pairs:
+        label, run = pair.split("=", 1)
+        rows = list(csv.DictReader(open(os.path.join(run, "probes.csv"))))
+        _, vtp = frame_at(run, "particles", float(rows[-1]["time"]))
+        p = read_vtp(vtp)
+        d = 2 * max(p["radius"]) if p["radius"] else 0
+        top = {}
+        for (x, y, z), r, v in zip(p["Points"], p["radius"], p["velocity"]):
+            rr = math.hypot(x - SIDE / 2, y - SIDE / 2)
+            if rr > PLATE_R + r or z < PLATE_Z or z > PLATE_Z + 0.01 or math.sqrt(sum(c * c for c in v)) > 0.05:
+                continue
+            b = int(rr / (0.5 * d))
+            top[b] = max(top.get(b, 0.0), z + r - PLATE_Z)
+        if top:
+            bins = sorted(top)
+            ax.plot([(b + 0.5) * 0.5 * d * 1e3 for b in bins], [top[b] * 1e3 for b in bins], marker=".", label=label)
+    ax.axvline(PLATE_R * 1e3, color="k", lw=0.8, ls=":")
+    ax.set_xlabel("distance from the plate's axis [mm]")
+    ax.set_ylabel("surface height above the plate [mm]")
+    ax.set_title("Heap surface on the plate at the end (particles at rest)")
+    ax.set_xlim(0, 13)
+    ax.set_ylim(0, 8)
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    print(out)
+
+
 def table(pairs):
     print("| run | on the plate at rest, end [mg] | mean over the last 0.2 s [mg] | parcels | out at the top [g] "
           "| largest overlap / R | angle [deg] | wall time [s] | fluid coupler: ms per exchange, share |")
@@ -112,6 +150,8 @@ def table(pairs):
 def main():
     if len(sys.argv) >= 5 and sys.argv[1] == "fields":
         fields(sys.argv[2], float(sys.argv[3]), sys.argv[4])
+    elif len(sys.argv) >= 4 and sys.argv[1] == "profile":
+        profile(sys.argv[2], sys.argv[3:])
     elif len(sys.argv) >= 3 and sys.argv[1] == "table":
         table(sys.argv[2:])
     else:

@@ -26,6 +26,8 @@ for r in "${runs[@]}"; do args+=(--runs "$out/$r" --label "$r"); done
 pairs=()
 for r in "${runs[@]}"; do pairs+=("$r=$out/$r"); done
 "$python" "$here/plot_chamber.py" table "${pairs[@]}" > "$out/report/table.md"
+"$python" "$here/plot_chamber.py" profile "$out/report/heap_profiles.png" \
+  $(for r in a4_none a6_none a8_none a4_sd a6_sd a8_sd; do printf '%s ' "$r=$out/$r"; done)
 for r in a4_none a4_sd a8_sd; do
   "$python" "$here/plot_chamber.py" fields "$out/$r" 0.8 "$out/report/fields_${r}_0.8s.png"
   "$python" "$here/plot_chamber.py" fields "$out/$r" 2.0 "$out/report/fields_${r}_2.0s.png"
