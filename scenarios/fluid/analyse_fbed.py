@@ -12,15 +12,28 @@ inlet on z_min and a pressure outlet on z_max):
     layer over it (void fraction above 0.999); their difference less the
     gas's own hydrostatic rho_f g dz is the bed's pressure drop;
   - it is averaged over the frames from --from (default 0.3 s) to the end;
-  - the bed's mean void fraction below its top, same window.
+  - the bed's mean void fraction below its top, same window;
+  - the bed's height from the particles (particles.pvd frames, same window):
+    twice the mean height of the particle centres above the floor (exact for
+    a bed of uniform density), and the void fraction it implies,
+    1 - V_particles / (A H).
 Prints a table and, with --plot, draws dp against U with the buoyant weight
-per area and Ergun's fixed-bed line at the void fraction of the slowest run.
-Usage: analyse_fbed.py [--from T] [--plot PNG] label=folder [label=folder ...]
+per area.
+With --umf (runs at several U of one bed): the minimum fluidisation velocity
+as Kunii & Levenspiel construct it, where the packed bed's line meets the
+weight: the runs whose dp stays below 0.95 of the weight are fitted with
+Ergun's form dp = a U + b U^2 (least squares), which is solved for dp =
+weight; eps_mf is the bed's void fraction (from its height) in the fastest of
+those runs. U_mf is compared with Wen & Yu's (1966) equation at that eps_mf,
+Ar = 150 (1 - eps)/eps^3 Re + 1.75/eps^3 Re^2 (spheres; Ergun's equation set
+equal to the buoyant weight, which is what their correlation's constants
+approximate), and with their correlation Re = sqrt(33.7^2 + 0.0408 Ar) - 33.7.
+Usage: analyse_fbed.py [--from T] [--plot PNG] [--umf] label=folder [label=folder ...]
 (the label names the run in the table; U is read from the scenario's inlet)."""
-import argparse, glob, json, math, os, sys
+import argparse, glob, json, math, os, re, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from vti import read_vti  # noqa: E402
+from vti import read_vti, read_vtp  # noqa: E402
 
 
 def layer_means(dims, arrays, name):
@@ -55,10 +68,50 @@ def analyse(folder, t_from, rho_f, g):
     return dps, epss
 
 
+def bed_height(folder, t_from):
+    """Mean over the particle frames from t_from of 2 x the mean centre height."""
+    text = open(os.path.join(folder, "particles.pvd")).read()
+    heights = []
+    for t, f in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', text):
+        if float(t) < t_from:
+            continue
+        zs = [p[2] for p in read_vtp(os.path.join(folder, f))["Points"]]
+        heights.append(2 * sum(zs) / len(zs))
+    return sum(heights) / len(heights) if heights else float("nan")
+
+
+def minimum_fluidisation(rows, rho_f, mu, rho_p, d, g):
+    packed = [r for r in rows if r[1] < 0.95 * r[5]]
+    if len(packed) < 2:
+        sys.exit("--umf: fewer than two runs below the weight")
+    # dp / U = a + b U, least squares over the packed runs
+    xs, ys = [r[0] for r in packed], [r[1] / r[0] for r in packed]
+    n = len(xs)
+    mx, my = sum(xs) / n, sum(ys) / n
+    b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+    a = my - b * mx
+    w = packed[0][5]
+    u_mf = (-a + math.sqrt(a * a + 4 * b * w)) / (2 * b) if b > 0 else w / a
+    eps = max(packed)[8]
+    ar = rho_f * (rho_p - rho_f) * g * d ** 3 / mu ** 2
+    qa, qb = 1.75 / eps ** 3, 150 * (1 - eps) / eps ** 3
+    re = (-qb + math.sqrt(qb * qb + 4 * qa * ar)) / (2 * qa)
+    u_wy = re * mu / (rho_f * d)
+    u_corr = (math.sqrt(33.7 ** 2 + 0.0408 * ar) - 33.7) * mu / (rho_f * d)
+    print()
+    print(f"packed runs fitted: {n} (U = {', '.join(f'{x:g}' for x in xs)} m/s); dp = {a:.1f} U + {b:.1f} U^2 Pa")
+    print(f"U_mf (fit meets the weight {w:.1f} Pa): {u_mf:.4f} m/s")
+    print(f"eps_mf (bed height at U = {max(packed)[0]:g} m/s): {eps:.4f}; Ar = {ar:.0f}")
+    print(f"Wen-Yu at eps_mf: U_mf = {u_wy:.4f} m/s; domel / Wen-Yu = {u_mf / u_wy:.3f} ({100 * (u_mf / u_wy - 1):+.1f} %)")
+    print(f"Wen-Yu's correlation (33.7, 0.0408): U_mf = {u_corr:.4f} m/s")
+    return a, b, u_mf, u_wy
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--from", dest="t_from", type=float, default=0.3)
     ap.add_argument("--plot")
+    ap.add_argument("--umf", action="store_true")
     ap.add_argument("runs", nargs="+")
     args = ap.parse_args()
     rows = []
@@ -79,25 +132,18 @@ def main():
         dps, epss = analyse(folder, args.t_from, rho_f, g)
         mean = sum(dps) / len(dps)
         sd = math.sqrt(sum((x - mean) ** 2 for x in dps) / max(len(dps) - 1, 1))
-        # the bed's height at the end from the state file: the 95th percentile
-        # of the particles' tops above the lowest particle's bottom
-        height = float("nan")
-        state = s.get("outputs", {}).get("state", {})
-        if state:
-            zs, r0 = [], None
-            for line in open(os.path.join(folder, list(state.values())[0])):
-                if line.startswith("#") or line.startswith("id"):
-                    continue
-                f = line.split(",")
-                zs.append((float(f[3]) + float(f[4]), float(f[3]) - float(f[4])))
-            tops = sorted(z[0] for z in zs)
-            height = tops[int(0.95 * (len(tops) - 1))] - min(z[1] for z in zs)
-        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label, height))
+        height = bed_height(folder, args.t_from)
+        eps_h = 1 - n * math.pi * d ** 3 / 6 / (area * height)
+        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label, height, eps_h))
+        props = (rho_f, mu, mat["density"], d, g)
     rows.sort()
-    print("| run | U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps (layers) | bed height at the end [mm] |")
-    print("|---|---|---|---|---|---|")
-    for u, mean, sd, nf, eps, w, label, height in rows:
-        print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} | {1e3 * height:.1f} |")
+    print("| run | U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps (layers) "
+          "| bed height [mm] | bed eps (height) |")
+    print("|---|---|---|---|---|---|---|")
+    for u, mean, sd, nf, eps, w, label, height, eps_h in rows:
+        print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} | {1e3 * height:.1f} "
+              f"| {eps_h:.3f} |")
+    umf = minimum_fluidisation(rows, *props) if args.umf else None
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")
@@ -106,6 +152,11 @@ def main():
         fig, ax = plt.subplots(figsize=(6, 4))
         ax.errorbar(us, [r[1] for r in rows], yerr=[r[2] for r in rows], fmt="o", label="domel (vans, gidaspow)")
         ax.axhline(rows[0][5], color="k", ls="--", label="buoyant weight / area")
+        if umf:
+            a, b, u_mf, u_wy = umf
+            xs = [u_mf * i / 50 for i in range(51)]
+            ax.plot(xs, [a * x + b * x * x for x in xs], "C0:", label=f"packed-bed fit, U_mf = {u_mf:.3f} m/s")
+            ax.axvline(u_wy, color="C3", ls="-.", label=f"Wen-Yu at eps_mf: {u_wy:.3f} m/s")
         ax.set_xlabel("superficial gas velocity U [m/s]")
         ax.set_ylabel("bed pressure drop [Pa]")
         ax.legend()

@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: MIT
-// Guards case (c) of docs/validation/fluid.md at CI size (label "slow",
-// about a minute and a half): 2187 glass beads of 1 mm in a 10 x 10 mm
-// column with frictionless walls, air from a velocity inlet below, the
-// built-in "vans" coupler with the Gidaspow law.
-//  - At U = 0.3 m/s (about half of minimum fluidisation) the bed stays
-//    packed and the pressure gradient inside it is Ergun's (1952) at
-//    the void fraction the coupler deposited there, within 10 % (a random
-//    packing's local eps varies over the 5 mm layers, and Ergun's gradient
-//    moves 5 % per 1 % of eps).
-//  - At U = 1.0 m/s (about 1.7 U_mf) the bed is fluidised and carries its
-//    buoyant weight: the pressure drop sampled every 5 ms over 0.3-1.0 s
-//    averages to the buoyant weight per area within 10 % (the column is 10
-//    beads wide and slugs: single samples scatter by about 25 %, and 140
-//    correlated samples leave a few per cent of sampling error).
+// Guards cases (c) and (d) of docs/validation/fluid.md at CI size (label
+// "slow"), with the beds of scenarios/fluid/bed/ (make_fbed.py): glass beads
+// of 1 mm dropped as a loose lattice into a column with frictionless walls,
+// air from a velocity inlet over the floor, the built-in "vans" coupler with
+// the Gidaspow law.
+//  (c) The minimum-fluidisation bed in a narrower column (6 x 6 mm, 2 x 2 x 40
+//      cells of 3 mm, 1485 beads, about 12 cells tall): two runs below U_mf
+//      give the packed bed's line dp = a U + b U^2, which meets the buoyant
+//      weight at U_mf; Wen & Yu's equation at the void fraction of the bed
+//      (from its height) gives the reference. One run above U_mf carries
+//      the weight and expands.
+//  (d) The bed of 39,616 beads as 4952 parcels of alpha = 2 and 619 of
+//      alpha = 4 at 1.2 m/s: with drag scaling both are fluidised and carry
+//      their weight; without it the alpha = 4 bed stays packed.
 #include "plugins/fluid/drag_laws.hpp"
 #include "support/fixture.hpp"
 
@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -33,43 +34,46 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kD = 1e-3, kRhoP = 2500, kRhoF = 1.2, kMu = 1.8e-5, kG = 9.81, kSide = 0.01;
+constexpr double kD = 1e-3, kRhoP = 2500, kRhoF = 1.2, kMu = 1.8e-5, kG = 9.81;
 
-json bed(double u, double duration) {
-  json doc = dt::scenario(dt::hertz_mindlin(), 5e-6, 0.9, 0.3, 1e7, 0.3, kRhoP);
-  doc["gravity"] = {0, 0, -kG};
-  doc["materials"]["wall"] = {{"youngs_modulus", 1e7}, {"poisson_ratio", 0.3}};
-  doc["interactions"].push_back({{"materials", {"m", "wall"}}, {"restitution", 0.9}, {"friction", 0.0}});
-  doc["walls"] = {{{"name", "column"}, {"type", "box"}, {"material", "wall"}, {"min", {0, 0, 0}},
-                   {"max", {kSide, kSide, 0.1}}, {"open", json::array()}}};
-  json box = {{"min", {0, 0, 0}}, {"max", {kSide, kSide, 0.03}}};
-  doc["subdomains"][0]["insert"] = json::array({json{{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.1},
-                                                     {"jitter", 0.04}, {"seed", 3}, {"region", {{"box", box}}}}});
-  json slip = {{"type", "slip_wall"}};
-  doc["fluid"] = {{"model", "vans"},
-                  {"interval", 1e-4},
-                  {"grid", {{"min", {0, 0, 0}}, {"max", {kSide, kSide, 0.1}}, {"cells", {2, 2, 20}}}},
-                  {"density", kRhoF},
-                  {"viscosity", kMu},
-                  {"drag", {{"law", "gidaspow"}}},
-                  {"boundaries",
-                   {{"x_min", slip}, {"x_max", slip}, {"y_min", slip}, {"y_max", slip},
-                    {"z_min", {{"type", "velocity_inlet"}, {"velocity", {0, 0, u}}}},
-                    {"z_max", {{"type", "pressure_outlet"}}}}},
-                  {"initial_velocity", {0, 0, u}},
-                  {"write_interval", 0}};
-  doc["run"] = {{"duration", duration}};
+json bed_file(const std::string& name) {
+  std::ifstream in(std::string(DOMEL_SOURCE_DIR) + "/scenarios/fluid/bed/" + name + ".json");
+  json doc = json::parse(in);
+  doc.erase("$schema");
+  doc["fluid"]["write_interval"] = 0;
+  doc["output"] = {{"vtk_interval", 0}, {"probe_interval", 0}};
   return doc;
 }
 
-struct Sample {
-  double dp;        ///< inlet face to above the bed, less the gas's hydrostatic part [Pa]
-  double eps;       ///< mean void fraction of the layers below the bed's top layer
-  double gradient;  ///< -dp/dz between the centres of layers 1 and 2, less rho_f g [Pa/m]
-  double eps_low;   ///< mean void fraction of layers 1 and 2
+/// The minimum-fluidisation bed at velocity u in a column of side x side
+/// with `count` beads (the file's grid of 3 mm cells, narrowed).
+json narrow_mf_bed(double u, double side, int cells, int count, double duration) {
+  json doc = bed_file("mf_u030");
+  doc["walls"][0]["max"][0] = side, doc["walls"][0]["max"][1] = side;
+  doc["fluid"]["grid"]["max"][0] = side, doc["fluid"]["grid"]["max"][1] = side;
+  doc["fluid"]["grid"]["cells"][0] = cells, doc["fluid"]["grid"]["cells"][1] = cells;
+  auto& insert = doc["subdomains"][0]["insert"][0];
+  insert["count"] = count;
+  insert["region"]["box"]["max"][0] = side, insert["region"]["box"]["max"][1] = side;
+  doc["fluid"]["boundaries"]["z_min"]["velocity"] = {0, 0, u};
+  doc["fluid"]["initial_velocity"] = {0, 0, u};
+  doc["run"]["duration"] = duration;
+  return doc;
+}
+
+struct Bed {
+  double dp = 0;       ///< mean pressure drop, inlet face to above the bed, less rho_f g z [Pa]
+  double height = 0;   ///< mean of 2 x the mean centre height [m]
+  double weight = 0;   ///< buoyant weight per area [Pa]
+  double eps = 0;      ///< void fraction from the height, 1 - V_p / (A height)
+  double lo = 0, hi = 0;  ///< smallest and largest dp sample [Pa]
+  int samples = 0;
 };
 
-Sample sample(const dp::Simulation& sim) {
+/// The bed's pressure drop from the fluid's layer means: from the inlet face
+/// (extrapolated from the two lowest layers) to the first clear layer above
+/// the bed, less the gas's own hydrostatic part.
+double pressure_drop(const dp::Simulation& sim) {
   domel_fluid_fields_v1 f{};
   sim.fluid->spec().model->fluid_fields(f);
   const double *p = nullptr, *e = nullptr;
@@ -83,64 +87,100 @@ Sample sample(const dp::Simulation& sim) {
     for (uint32_t c = 0; c < per; ++c) pl[k] += p[k * per + c] / per, el[k] += e[k * per + c] / per;
   uint32_t top = 1;
   while (top + 1 < f.nz && el[top] <= 0.999) ++top;
-  double eps = 0;
-  for (uint32_t k = 0; k < top; ++k) eps += el[k] / top;
   const double z_top = (top + 0.5) * f.spacing[2];
-  const double p_inlet = pl[0] + 0.5 * (pl[0] - pl[1]);  // extrapolated to the inlet face
-  const double gradient = (pl[1] - pl[2]) / f.spacing[2] - kRhoF * kG;
-  return {p_inlet - pl[top] - kRhoF * kG * z_top, eps, gradient, 0.5 * (el[1] + el[2])};
+  const double p_inlet = pl[0] + 0.5 * (pl[0] - pl[1]);
+  return p_inlet - pl[top] - kRhoF * kG * z_top;
 }
 
-/// Runs the bed at superficial velocity u and averages samples taken every
-/// 5 ms from t_from on.
-Sample run_bed(double u, double duration, double t_from, std::size_t* particles, std::vector<double>* dps) {
-  auto sim = dt::build(bed(u, duration));
-  *particles = sim->subdomains[0]->store().size();
+/// Runs a bed and averages samples taken every 5 ms from t_from on.
+Bed run_bed(const json& doc, double t_from) {
+  auto sim = dt::build(doc);
+  const auto& store = sim->subdomains[0]->store();
+  const double side_x = doc["fluid"]["grid"]["max"][0].get<double>(), side_y = doc["fluid"]["grid"]["max"][1].get<double>();
+  double mass = 0, volume = 0;
+  for (std::size_t i = 0; i < store.size(); ++i)
+    mass += store.mass[i], volume += 4.0 / 3.0 * M_PI * std::pow(store.radius[i], 3);
+  Bed bed;
+  bed.weight = mass * kG * (1 - kRhoF / kRhoP) / (side_x * side_y);
+  bed.lo = 1e300, bed.hi = -1e300;
   const auto every = static_cast<std::uint64_t>(std::llround(5e-3 / sim->macro_step()));
-  Sample mean{0, 0, 0, 0};
-  int n = 0;
   dp::Simulation* raw = sim.get();
   sim->hooks.after.push_back([&](const dp::MacroStep& step) {
     if ((step.index + 1) % every != 0 || step.t < t_from) return;
-    const Sample s = sample(*raw);
-    mean.dp += s.dp, mean.eps += s.eps, mean.gradient += s.gradient, mean.eps_low += s.eps_low;
-    dps->push_back(s.dp);
-    ++n;
+    const double d = pressure_drop(*raw);
+    double z = 0;
+    for (std::size_t i = 0; i < store.size(); ++i) z += store.z[i];
+    bed.dp += d, bed.height += 2 * z / store.size();
+    bed.lo = std::min(bed.lo, d), bed.hi = std::max(bed.hi, d);
+    ++bed.samples;
   });
   dp::RunOptions o;
   o.output_directory = std::filesystem::temp_directory_path() / ("domel_fbed_" + std::to_string(getpid()));
   o.progress = false;
   sim->run(o, dt::builtin_registry());
   std::filesystem::remove_all(o.output_directory);
-  return {mean.dp / n, mean.eps / n, mean.gradient / n, mean.eps_low / n};
+  bed.dp /= bed.samples, bed.height /= bed.samples;
+  bed.eps = 1 - volume / (side_x * side_y * bed.height);
+  return bed;
+}
+
+void print(const char* what, double u, const Bed& b) {
+  std::printf("[fluidised bed] %s U = %.2f m/s: dp %.1f Pa (%d samples, %.1f-%.1f) = %.3f of the weight %.1f Pa; "
+              "height %.1f mm, eps %.3f\n",
+              what, u, b.dp, b.samples, b.lo, b.hi, b.dp / b.weight, b.weight, 1e3 * b.height, b.eps);
 }
 
 }  // namespace
 
-TEST(FluidisedBed, PackedBelowAndCarriedAboveMinimumFluidisation) {
-  std::size_t n = 0;
-  std::vector<double> packed_dps, fluid_dps;
-  const Sample packed = run_bed(0.3, 0.3, 0.2, &n, &packed_dps);
-  const double weight = n * kRhoP * M_PI * kD * kD * kD / 6 * kG * (1 - kRhoF / kRhoP) / (kSide * kSide);
-  // Ergun inside the packed bed: the gradient across the face between
-  // layers 1 and 2 against Ergun's at those layers' mean void fraction. The
-  // bed is four layers of 5 mm, the top one partly filled; the face above
-  // the floor layer is not used: the drag of the particles next to the inlet
-  // (whose face velocity is fixed) is deposited on it, so it carries more
-  // than its share while the bed's total is kept.
-  const double ergun = fl::ergun_pressure_gradient(0.3, packed.eps_low, kD, kRhoF, kMu);
-  std::printf("[fluidised bed] %zu beads, buoyant weight / area %.1f Pa\n", n, weight);
-  std::printf("[fluidised bed] U = 0.3 m/s: dp %.1f Pa; inside the bed eps %.3f, -dp/dz %.0f Pa/m, Ergun %.0f Pa/m "
-              "(%+.1f %%)\n",
-              packed.dp, packed.eps_low, packed.gradient, ergun, 100 * (packed.gradient / ergun - 1));
-  EXPECT_NEAR(packed.gradient, ergun, 0.10 * ergun);
-  EXPECT_LT(packed.dp, 0.6 * weight);  // not fluidised
+TEST(FluidisedBed, MinimumFluidisationMeetsWenYuAtTheBedsVoidFraction) {
+  constexpr double kSide = 0.006;
+  constexpr int kCells = 2, kCount = 1485;
+  // Two packed runs: the bed settles in about 0.2 s; the samples after it
+  // do not vary (a packed bed).
+  const double u1 = 0.3, u2 = 0.45;
+  const Bed b1 = run_bed(narrow_mf_bed(u1, kSide, kCells, kCount, 0.35), 0.25);
+  const Bed b2 = run_bed(narrow_mf_bed(u2, kSide, kCells, kCount, 0.35), 0.25);
+  print("packed", u1, b1);
+  print("packed", u2, b2);
+  ASSERT_LT(b2.dp, 0.95 * b2.weight) << "the bed is not packed at " << u2 << " m/s";
+  // dp / U = a + b U through the two runs; U_mf where a U + b U^2 = weight.
+  const double b = (b2.dp / u2 - b1.dp / u1) / (u2 - u1), a = b1.dp / u1 - b * u1;
+  const double u_mf = (-a + std::sqrt(a * a + 4 * b * b2.weight)) / (2 * b);
+  const double wen_yu = fl::ergun_minimum_fluidisation_velocity(kD, kRhoP, kRhoF, kMu, kG, b2.eps);
+  std::printf("[fluidised bed] U_mf %.4f m/s; Wen-Yu at eps_mf %.3f: %.4f m/s (%+.1f %%); their correlation %.4f m/s\n",
+              u_mf, b2.eps, wen_yu, 100 * (u_mf / wen_yu - 1),
+              fl::wen_yu_minimum_fluidisation_velocity(kD, kRhoP, kRhoF, kMu, kG));
+  EXPECT_NEAR(u_mf, wen_yu, 0.10 * wen_yu);  // the 10 %
 
-  const Sample fluid = run_bed(1.0, 1.0, 0.3, &n, &fluid_dps);
-  double lo = fluid_dps.front(), hi = lo;
-  for (double v : fluid_dps) lo = std::min(lo, v), hi = std::max(hi, v);
-  std::printf("[fluidised bed] U = 1.0 m/s: dp %.1f Pa (%zu samples, %.1f-%.1f), %.3f of the weight, eps %.3f\n",
-              fluid.dp, fluid_dps.size(), lo, hi, fluid.dp / weight, fluid.eps);
-  EXPECT_NEAR(fluid.dp, weight, 0.10 * weight);
-  EXPECT_GT(fluid.eps, packed.eps + 0.03);  // the bed has expanded
+  // Above U_mf the bed carries its weight (10 %: the column is 6 beads wide
+  // and slugs; single samples scatter by tens of per cent) and expands.
+  const Bed f = run_bed(narrow_mf_bed(1.0, kSide, kCells, kCount, 0.6), 0.3);
+  print("fluidised", 1.0, f);
+  EXPECT_NEAR(f.dp, f.weight, 0.10 * f.weight);
+  EXPECT_GT(f.eps, b2.eps + 0.05);
+}
+
+TEST(FluidisedBed, CoarseGrainedBedsAreFluidisedOnlyWithDragScaling) {
+  auto shortened = [](json doc) {
+    doc["run"]["duration"] = 0.6;
+    return doc;
+  };
+  const Bed a2 = run_bed(shortened(bed_file("a2")), 0.3);
+  const Bed a4 = run_bed(shortened(bed_file("a4")), 0.3);
+  const Bed a4u = run_bed(shortened(bed_file("a4_unscaled")), 0.3);
+  print("alpha 2, scaled,", 1.2, a2);
+  print("alpha 4, scaled,", 1.2, a4);
+  print("alpha 4, unscaled,", 1.2, a4u);
+  // The same mass at both ratios.
+  EXPECT_NEAR(a2.weight, a4.weight, 1e-9 * a4.weight);
+  // Scaled: fluidised, carrying the weight (10 %: sampling error of a
+  // slugging bed, as above) and expanded well past a packing.
+  EXPECT_NEAR(a2.dp, a2.weight, 0.10 * a2.weight);
+  EXPECT_NEAR(a4.dp, a4.weight, 0.10 * a4.weight);
+  EXPECT_GT(a2.eps, 0.6);
+  EXPECT_GT(a4.eps, 0.6);
+  // Unscaled: a parcel of 4 mm needs about 2 m/s; at 1.2 m/s the bed stays
+  // packed and carries less than half its weight.
+  EXPECT_LT(a4u.dp, 0.6 * a4u.weight);
+  EXPECT_LT(a4u.eps, 0.46);
 }
