@@ -4,7 +4,7 @@
 # report over all of them, the table and the pictures.
 #   scenarios/fluid/run_chamber.sh OUTDIR [JOBS]        (JOBS: default nproc)
 # Runs already finished in OUTDIR (a summary.json) are kept, not redone.
-# About 35 minutes on 2 cores (the two alpha = 4 runs take 13-14 minutes each).
+# About 1.5 hours on 2 cores (the two alpha = 4 runs take about 45 minutes each).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
