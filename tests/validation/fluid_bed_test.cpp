@@ -12,7 +12,10 @@
 //      the weight and expands.
 //  (d) The bed of 39,616 beads as 4952 parcels of alpha = 2 and 619 of
 //      alpha = 4 at 1.2 m/s: with drag scaling both are fluidised and carry
-//      their weight; without it the alpha = 4 bed stays packed.
+//      the same weight; without it the alpha = 4 bed stays packed. The bed
+//      expansion is compared across alpha only at full size, in a column
+//      twice as wide (docs/validation/fluid.md: in this 24 mm column, six
+//      parcels across at alpha = 4, the alpha = 4 bed expands less).
 #include "plugins/fluid/drag_laws.hpp"
 #include "support/fixture.hpp"
 
@@ -177,6 +180,7 @@ TEST(FluidisedBed, CoarseGrainedBedsAreFluidisedOnlyWithDragScaling) {
   // slugging bed, as above) and expanded well past a packing.
   EXPECT_NEAR(a2.dp, a2.weight, 0.10 * a2.weight);
   EXPECT_NEAR(a4.dp, a4.weight, 0.10 * a4.weight);
+  EXPECT_NEAR(a4.dp, a2.dp, 0.05 * a2.dp);  // the 5 %
   EXPECT_GT(a2.eps, 0.6);
   EXPECT_GT(a4.eps, 0.6);
   // Unscaled: a parcel of 4 mm needs about 2 m/s; at 1.2 m/s the bed stays
