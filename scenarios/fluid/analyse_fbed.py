@@ -28,7 +28,11 @@ those runs. U_mf is compared with Wen & Yu's (1966) equation at that eps_mf,
 Ar = 150 (1 - eps)/eps^3 Re + 1.75/eps^3 Re^2 (spheres; Ergun's equation set
 equal to the buoyant weight, which is what their correlation's constants
 approximate), and with their correlation Re = sqrt(33.7^2 + 0.0408 Ar) - 33.7.
-Usage: analyse_fbed.py [--from T] [--plot PNG] [--umf] label=folder [label=folder ...]
+With --heights PNG: the bed's height (twice the mean centre height) against
+time, one line per run, to compare runs that oscillate (a slugging bed's
+height swings by tens of per cent over a few tenths of a second, so a mean
+over a short window depends on where in the swing it falls).
+Usage: analyse_fbed.py [--from T] [--plot PNG] [--umf] [--heights PNG] label=folder [label=folder ...]
 (the label names the run in the table; U is read from the scenario's inlet)."""
 import argparse, glob, json, math, os, re, sys
 
@@ -68,15 +72,19 @@ def analyse(folder, t_from, rho_f, g):
     return dps, epss
 
 
-def bed_height(folder, t_from):
-    """Mean over the particle frames from t_from of 2 x the mean centre height."""
+def height_series(folder):
+    """(t, 2 x the mean centre height) of every particle frame."""
     text = open(os.path.join(folder, "particles.pvd")).read()
-    heights = []
+    out = []
     for t, f in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', text):
-        if float(t) < t_from:
-            continue
         zs = [p[2] for p in read_vtp(os.path.join(folder, f))["Points"]]
-        heights.append(2 * sum(zs) / len(zs))
+        out.append((float(t), 2 * sum(zs) / len(zs)))
+    return out
+
+
+def bed_height(series, t_from):
+    """Mean over the particle frames from t_from of 2 x the mean centre height."""
+    heights = [h for t, h in series if t >= t_from]
     return sum(heights) / len(heights) if heights else float("nan")
 
 
@@ -112,9 +120,10 @@ def main():
     ap.add_argument("--from", dest="t_from", type=float, default=0.3)
     ap.add_argument("--plot")
     ap.add_argument("--umf", action="store_true")
+    ap.add_argument("--heights")
     ap.add_argument("runs", nargs="+")
     args = ap.parse_args()
-    rows = []
+    rows, all_series = [], []
     for spec in args.runs:
         label, folder = spec.split("=", 1)
         s = json.load(open(os.path.join(folder, "summary.json")))
@@ -132,7 +141,9 @@ def main():
         dps, epss = analyse(folder, args.t_from, rho_f, g)
         mean = sum(dps) / len(dps)
         sd = math.sqrt(sum((x - mean) ** 2 for x in dps) / max(len(dps) - 1, 1))
-        height = bed_height(folder, args.t_from)
+        series = height_series(folder)
+        all_series.append((label, series))
+        height = bed_height(series, args.t_from)
         eps_h = 1 - n * math.pi * d ** 3 / 6 / (area * height)
         rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label, height, eps_h))
         props = (rho_f, mu, mat["density"], d, g)
@@ -144,6 +155,19 @@ def main():
         print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} | {1e3 * height:.1f} "
               f"| {eps_h:.3f} |")
     umf = minimum_fluidisation(rows, *props) if args.umf else None
+    if args.heights:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for label, series in all_series:
+            ax.plot([t for t, _ in series], [1e3 * h for _, h in series], label=label)
+        ax.axvline(args.t_from, color="k", ls=":", lw=0.8)
+        ax.set_xlabel("simulated time [s]")
+        ax.set_ylabel("bed height, 2 x mean centre height [mm]")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(args.heights, dpi=120)
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")
