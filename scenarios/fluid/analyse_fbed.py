@@ -34,10 +34,22 @@ height swings by tens of per cent over a few tenths of a second, so a mean
 over a short window depends on where in the swing it falls).
 Usage: analyse_fbed.py [--from T] [--plot PNG] [--umf] [--heights PNG] label=folder [label=folder ...]
 (the label names the run in the table; U is read from the scenario's inlet)."""
-import argparse, glob, json, math, os, re, sys
+import argparse, collections, glob, json, math, os, re, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from vti import read_vti, read_vtp  # noqa: E402
+
+
+# One run's figures: U, mean dp, its sd, frames, layer eps, buoyant weight per
+# area, label, bed height, eps from the height.
+Run = collections.namedtuple("Run", "u dp sd frames eps weight label height eps_h")
+
+
+def pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
 
 
 def layer_means(dims, arrays, name):
@@ -89,18 +101,22 @@ def bed_height(series, t_from):
 
 
 def minimum_fluidisation(rows, rho_f, mu, rho_p, d, g):
-    packed = [r for r in rows if r[1] < 0.95 * r[5]]
+    packed = [r for r in rows if r.dp < 0.95 * r.weight]
     if len(packed) < 2:
         sys.exit("--umf: fewer than two runs below the weight")
     # dp / U = a + b U, least squares over the packed runs
-    xs, ys = [r[0] for r in packed], [r[1] / r[0] for r in packed]
+    xs, ys = [r.u for r in packed], [r.dp / r.u for r in packed]
     n = len(xs)
     mx, my = sum(xs) / n, sum(ys) / n
     b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
     a = my - b * mx
-    w = packed[0][5]
+    w = packed[0].weight
     u_mf = (-a + math.sqrt(a * a + 4 * b * w)) / (2 * b) if b > 0 else w / a
-    eps = max(packed)[8]
+    fastest = max(packed)
+    eps = fastest.eps_h
+    # Wen & Yu (1966) at eps_mf and their correlation: the formulas of
+    # plugins/fluid/drag_laws.hpp (ergun_minimum_fluidisation_velocity,
+    # wen_yu_minimum_fluidisation_velocity), which the CI test calls
     ar = rho_f * (rho_p - rho_f) * g * d ** 3 / mu ** 2
     qa, qb = 1.75 / eps ** 3, 150 * (1 - eps) / eps ** 3
     re = (-qb + math.sqrt(qb * qb + 4 * qa * ar)) / (2 * qa)
@@ -109,7 +125,7 @@ def minimum_fluidisation(rows, rho_f, mu, rho_p, d, g):
     print()
     print(f"packed runs fitted: {n} (U = {', '.join(f'{x:g}' for x in xs)} m/s); dp = {a:.1f} U + {b:.1f} U^2 Pa")
     print(f"U_mf (fit meets the weight {w:.1f} Pa): {u_mf:.4f} m/s")
-    print(f"eps_mf (bed height at U = {max(packed)[0]:g} m/s): {eps:.4f}; Ar = {ar:.0f}")
+    print(f"eps_mf (bed height at U = {fastest.u:g} m/s): {eps:.4f}; Ar = {ar:.0f}")
     print(f"Wen-Yu at eps_mf: U_mf = {u_wy:.4f} m/s; domel / Wen-Yu = {u_mf / u_wy:.3f} ({100 * (u_mf / u_wy - 1):+.1f} %)")
     print(f"Wen-Yu's correlation (33.7, 0.0408): U_mf = {u_corr:.4f} m/s")
     return a, b, u_mf, u_wy
@@ -145,20 +161,18 @@ def main():
         all_series.append((label, series))
         height = bed_height(series, args.t_from)
         eps_h = 1 - n * math.pi * d ** 3 / 6 / (area * height)
-        rows.append((float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label, height, eps_h))
+        rows.append(Run(float(u), mean, sd, len(dps), sum(epss) / len(epss), weight, label, height, eps_h))
         props = (rho_f, mu, mat["density"], d, g)
     rows.sort()
     print("| run | U [m/s] | dp [Pa] (mean ± sd, frames) | dp / buoyant weight per area | bed eps (layers) "
           "| bed height [mm] | bed eps (height) |")
     print("|---|---|---|---|---|---|---|")
-    for u, mean, sd, nf, eps, w, label, height, eps_h in rows:
-        print(f"| {label} | {u:g} | {mean:.1f} ± {sd:.1f} ({nf}) | {mean / w:.3f} | {eps:.3f} | {1e3 * height:.1f} "
-              f"| {eps_h:.3f} |")
+    for r in rows:
+        print(f"| {r.label} | {r.u:g} | {r.dp:.1f} ± {r.sd:.1f} ({r.frames}) | {r.dp / r.weight:.3f} | {r.eps:.3f} "
+              f"| {1e3 * r.height:.1f} | {r.eps_h:.3f} |")
     umf = minimum_fluidisation(rows, *props) if args.umf else None
     if args.heights:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
         fig, ax = plt.subplots(figsize=(7, 4))
         for label, series in all_series:
             ax.plot([t for t, _ in series], [1e3 * h for _, h in series], label=label)
@@ -169,13 +183,11 @@ def main():
         fig.tight_layout()
         fig.savefig(args.heights, dpi=120)
     if args.plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        us = [r[0] for r in rows]
+        plt = pyplot()
+        us = [r.u for r in rows]
         fig, ax = plt.subplots(figsize=(6, 4))
-        ax.errorbar(us, [r[1] for r in rows], yerr=[r[2] for r in rows], fmt="o", label="domel (vans, gidaspow)")
-        ax.axhline(rows[0][5], color="k", ls="--", label="buoyant weight / area")
+        ax.errorbar(us, [r.dp for r in rows], yerr=[r.sd for r in rows], fmt="o", label="domel (vans, gidaspow)")
+        ax.axhline(rows[0].weight, color="k", ls="--", label="buoyant weight / area")
         if umf:
             a, b, u_mf, u_wy = umf
             xs = [u_mf * i / 50 for i in range(51)]
