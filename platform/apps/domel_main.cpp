@@ -31,11 +31,14 @@ constexpr int kExitUsage = 64;
 const char* kUsage = R"(usage: domel <command> [options]
 
 commands:
-  run FILE [--out DIR] [--threads N] [--max-steps N] [--time-after N] [--quiet] [--verbose]
+  run FILE [--out DIR] [--threads N] [--max-steps N] [--time-after N] [--restart CHECKPOINT]
+      [--quiet] [--verbose]
                       validate and run a scenario; writes particles_*.vtp + particles.pvd
                       (ParaView), probes.csv and summary.json into the output folder.
                       --max-steps stops early; --time-after N also reports the speed of
-                      the steps after the first N (benchmarks, in summary.json)
+                      the steps after the first N (benchmarks, in summary.json);
+                      --restart continues the run that wrote CHECKPOINT (run.checkpoint_interval)
+                      in its folder, bit-identically on the same thread count
   compare FILE --vary POINTER=VALUE[;POINTER=VALUE...] [--vary ...] [--label NAME ...]
           [--out DIR] [--threads N] [--max-steps N]
                       run variants of one scenario (same seeds and insertion) and write
@@ -136,14 +139,17 @@ void load_default_plugins(dp::PluginRegistry& registry) {
 void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
   std::fprintf(stderr, "domel: %s has %zu problem%s:\n", what.c_str(), diags.size(), diags.size() == 1 ? "" : "s");
   for (const auto& d : diags) {
-    std::string line = "  - at " + (d.pointer.empty() ? std::string("/") : d.pointer) + ": " + d.message;
+    // a problem in another file (a checkpoint, a state file) names it
+    const std::string in = !d.file.empty() && d.file != what ? d.file + ", " : "";
+    std::string line = "  - " + in + "at " + (d.pointer.empty() ? std::string("/") : d.pointer) + ": " + d.message;
     if (!d.hint.empty()) line += " (" + d.hint + ")";
     std::fprintf(stderr, "%s\n", line.c_str());
   }
 }
 
 int cmd_run(int argc, char** argv) {
-  const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps", "--time-after"}, {"--quiet", "--verbose"});
+  const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps", "--time-after", "--restart"},
+                       {"--quiet", "--verbose"});
   if (a.positional.size() != 1) throw UsageError("run expects one scenario file");
   check_thread_environment();
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
@@ -153,6 +159,11 @@ int cmd_run(int argc, char** argv) {
   if (auto t = a.option("--threads")) opt.threads = parse_threads(*t);
   if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
   if (auto s = a.option("--time-after")) opt.time_after = static_cast<std::uint64_t>(parse_count("--time-after", *s));
+  if (auto r = a.option("--restart")) {
+    opt.restart = *r;
+    // a restart continues the checkpointed run's files, in its folder
+    if (opt.output_directory.empty()) opt.output_directory = opt.restart.parent_path().empty() ? "." : opt.restart.parent_path();
+  }
   opt.progress = !a.flag("--quiet");
 
   dp::PluginRegistry registry;
@@ -166,7 +177,14 @@ int cmd_run(int argc, char** argv) {
     return kExitRefused;
   }
   try {
-    const auto result = sim->run(opt, registry);
+    dp::RunResult result;
+    try {
+      result = sim->run(opt, registry);
+    } catch (const dp::ConfigError& e) {
+      print_diagnostics(a.positional[0], e.diagnostics());
+      std::fprintf(stderr, "nothing was run.\n");
+      return kExitRefused;
+    }
     std::printf("%s: %llu steps, %.6g s simulated, %.3g s wall, %.3g particle-steps/s; output in %s\n",
                 sim->name.c_str(), static_cast<unsigned long long>(result.macro_steps), result.simulated_time,
                 result.wall_seconds, result.particle_steps_per_second, result.output_directory.string().c_str());

@@ -2,6 +2,7 @@
 // Cell-list construction of the Verlet list and history carry-over.
 #include "core/neighbor_list.hpp"
 
+#include "core/archive.hpp"
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -355,6 +356,49 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   built_size_ = n;
   built_version_ = s.layout_version;
   ++builds_;
+}
+
+}  // namespace domel::platform
+
+// ---- checkpoints ----------------------------------------------------------
+
+namespace domel::platform {
+
+void NeighborList::save(ArchiveWriter& w, const std::string& p) const {
+  w.put(p + "i", i);
+  w.put(p + "j", j);
+  w.put(p + "history", history);
+  w.put(p + "touching", touching);
+  w.put(p + "x0", x0_);
+  w.put(p + "y0", y0_);
+  w.put(p + "z0", z0_);
+  w.put(p + "built_ids", built_ids_);
+  w.put(p + "counters", std::vector<std::uint64_t>{builds_, built_size_, built_version_, near_size_, stride_});
+  w.put_scalar(p + "skin", skin_);
+}
+
+void NeighborList::load(const ArchiveReader& r, const std::string& p) {
+  r.get_into(p + "i", i);
+  r.get_into(p + "j", j);
+  r.get_into(p + "history", history);
+  r.get_into(p + "touching", touching);
+  r.get_into(p + "x0", x0_);
+  r.get_into(p + "y0", y0_);
+  r.get_into(p + "z0", z0_);
+  r.get_into(p + "built_ids", built_ids_);
+  const auto c = r.get<std::uint64_t>(p + "counters");
+  if (c.size() != 5) r.fail(p + "counters", "holds " + std::to_string(c.size()) + " values, expected 5");
+  if (c[4] != stride_)
+    r.fail(p + "counters", "holds contact histories of " + std::to_string(c[4]) +
+                               " values per pair; this scenario's contact model keeps " + std::to_string(stride_));
+  if (r.scalar<double>(p + "skin") != skin_) r.fail(p + "skin", "was written with another neighbour-list skin");
+  builds_ = c[0];
+  built_size_ = c[1];
+  built_version_ = c[2];
+  near_size_ = c[3];
+  if (j.size() != i.size() || touching.size() != i.size() || history.size() != i.size() * stride_ ||
+      near_size_ > i.size())
+    r.fail(p + "i", "holds a neighbour list whose arrays disagree in length");
 }
 
 }  // namespace domel::platform

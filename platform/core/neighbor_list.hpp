@@ -13,9 +13,13 @@
 #include "core/thread_pool.hpp"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace domel::platform {
+
+class ArchiveWriter;
+class ArchiveReader;
 
 class NeighborList {
  public:
@@ -63,6 +67,11 @@ class NeighborList {
            built_ids_.capacity() * sizeof(std::uint64_t);
   }
   std::size_t builds() const { return builds_; }
+  /// The whole list as the next step would find it (pairs, tiers, history,
+  /// contact flags, positions and ids at the last build, build counters), so
+  /// that a restarted run goes on with the same list (checkpoints).
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void load(const ArchiveReader& r, const std::string& prefix);
 
   std::vector<uint32_t> i, j;      ///< particle indices, id[i] < id[j]
   std::vector<double> history;     ///< size() * stride

@@ -2,6 +2,7 @@
 // Particle store mutations: append, swap-remove and permutation.
 #include "core/particle_store.hpp"
 
+#include "core/archive.hpp"
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -82,6 +83,61 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
     for (std::size_t k = 0; k < order.size(); ++k) v[k] = tmp[order[k]];
   });
   ++layout_version;
+}
+
+}  // namespace domel::platform
+
+// ---- checkpoints ----------------------------------------------------------
+
+namespace domel::platform {
+
+void ParticleStore::save(ArchiveWriter& w, const std::string& p) const {
+  w.put(p + "id", id);
+  const std::pair<const char*, const std::vector<double>*> reals[] = {
+      {"x", &x}, {"y", &y}, {"z", &z}, {"vx", &vx}, {"vy", &vy}, {"vz", &vz}, {"wx", &wx}, {"wy", &wy},
+      {"wz", &wz}, {"fx", &fx}, {"fy", &fy}, {"fz", &fz}, {"tx", &tx}, {"ty", &ty}, {"tz", &tz},
+      {"radius", &radius}, {"mass", &mass}, {"inv_mass", &inv_mass}, {"inv_inertia", &inv_inertia}};
+  for (const auto& [name, v] : reals) w.put(p + name, *v);
+  w.put(p + "contacts", contacts);
+  w.put(p + "flags", flags);
+  w.put_scalar<std::uint8_t>(p + "external_force", external_force_ ? 1 : 0);
+  if (external_force_) {
+    w.put(p + "ext_fx", ext_fx);
+    w.put(p + "ext_fy", ext_fy);
+    w.put(p + "ext_fz", ext_fz);
+  }
+  w.put_scalar<std::uint64_t>(p + "aux_count", aux.size());
+  for (std::size_t a = 0; a < aux.size(); ++a) w.put(p + "aux" + std::to_string(a), aux[a]);
+  w.put_scalar<std::uint64_t>(p + "layout_version", layout_version);
+}
+
+void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
+  r.get_into(p + "id", id);
+  const std::pair<const char*, std::vector<double>*> reals[] = {
+      {"x", &x}, {"y", &y}, {"z", &z}, {"vx", &vx}, {"vy", &vy}, {"vz", &vz}, {"wx", &wx}, {"wy", &wy},
+      {"wz", &wz}, {"fx", &fx}, {"fy", &fy}, {"fz", &fz}, {"tx", &tx}, {"ty", &ty}, {"tz", &tz},
+      {"radius", &radius}, {"mass", &mass}, {"inv_mass", &inv_mass}, {"inv_inertia", &inv_inertia}};
+  for (const auto& [name, v] : reals) r.get_into(p + name, *v);
+  r.get_into(p + "contacts", contacts);
+  r.get_into(p + "flags", flags);
+  external_force_ = r.scalar<std::uint8_t>(p + "external_force") != 0;
+  if (external_force_) {
+    r.get_into(p + "ext_fx", ext_fx);
+    r.get_into(p + "ext_fy", ext_fy);
+    r.get_into(p + "ext_fz", ext_fz);
+  } else {
+    ext_fx.clear(); ext_fy.clear(); ext_fz.clear();
+  }
+  const auto n_aux = r.scalar<std::uint64_t>(p + "aux_count");
+  if (n_aux != aux.size())
+    r.fail(p + "aux_count", "holds " + std::to_string(n_aux) + " extra per-particle arrays; this scenario uses " +
+                                std::to_string(aux.size()));
+  for (std::size_t a = 0; a < aux.size(); ++a) r.get_into(p + "aux" + std::to_string(a), aux[a]);
+  layout_version = r.scalar<std::uint64_t>(p + "layout_version");
+  const std::size_t n = id.size();
+  bool same = true;
+  for_each_array([&](const auto& v) { same = same && v.size() == n; });
+  if (!same) r.fail(p + "id", "has per-particle arrays of different lengths");
 }
 
 }  // namespace domel::platform

@@ -6,9 +6,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace domel::platform {
+
+class ArchiveWriter;
+class ArchiveReader;
 
 struct ParticleStore {
   std::vector<std::uint64_t> id;           ///< unique within the run, stable
@@ -103,6 +107,13 @@ struct ParticleStore {
   void for_each_array(F&& f) const {
     const_cast<ParticleStore*>(this)->for_each_array([&f](const auto& v) { f(v); });
   }
+
+  /// Every array, the external-force switch, the aux count and the layout
+  /// version, under `prefix` (checkpoints, core/archive.hpp).
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  /// The inverse of save(); throws ConfigError when a section is missing or
+  /// the arrays' lengths disagree.
+  void load(const ArchiveReader& r, const std::string& prefix);
 
   /// Bytes held by the arrays (their capacity).
   std::size_t bytes() const {

@@ -2,6 +2,7 @@
 // Building wall candidate lists and carrying their history over.
 #include "geometry/wall_neighbors.hpp"
 
+#include "core/archive.hpp"
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
@@ -90,6 +91,36 @@ void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double
     }
   }
   built = true;
+}
+
+}  // namespace domel::platform
+
+// ---- checkpoints ----------------------------------------------------------
+
+namespace domel::platform {
+
+void WallNeighbors::save(ArchiveWriter& w, const std::string& p) const {
+  w.put(p + "particle", particle);
+  w.put(p + "particle_id", particle_id);
+  w.put(p + "triangle", triangle);
+  w.put(p + "history", history);
+  w.put(p + "touching", touching);
+  w.put_scalar(p + "built_elapsed", built_elapsed);
+  w.put_scalar<std::uint8_t>(p + "built", built ? 1 : 0);
+}
+
+void WallNeighbors::load(const ArchiveReader& r, const std::string& p) {
+  r.get_into(p + "particle", particle);
+  r.get_into(p + "particle_id", particle_id);
+  r.get_into(p + "triangle", triangle);
+  r.get_into(p + "history", history);
+  r.get_into(p + "touching", touching);
+  built_elapsed = r.scalar<double>(p + "built_elapsed");
+  built = r.scalar<std::uint8_t>(p + "built") != 0;
+  grid_valid_ = false;
+  if (particle_id.size() != particle.size() || touching.size() != particle.size() ||
+      (!triangle.empty() && triangle.size() != particle.size()))
+    r.fail(p + "particle", "holds a wall candidate list whose arrays disagree in length");
 }
 
 }  // namespace domel::platform

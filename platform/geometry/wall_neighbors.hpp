@@ -15,6 +15,9 @@
 
 namespace domel::platform {
 
+class ArchiveWriter;
+class ArchiveReader;
+
 /// Candidate particles of one wall primitive, with per-contact history.
 class WallNeighbors {
  public:
@@ -29,6 +32,10 @@ class WallNeighbors {
     return (particle.capacity() + triangle.capacity()) * sizeof(uint32_t) +
            particle_id.capacity() * sizeof(std::uint64_t) + touching.capacity();
   }
+  /// The candidates, their history and build state (checkpoints; the
+  /// triangle grid is a cache, rebuilt on demand).
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void load(const ArchiveReader& r, const std::string& prefix);
   std::vector<uint32_t> particle;      ///< particle indices at this build (ascending)
   std::vector<std::uint64_t> particle_id;  ///< their ids (history is carried over by id)
   std::vector<uint32_t> triangle;      ///< mesh walls: the candidate triangle of each entry

@@ -5,9 +5,12 @@
 #include "io/csv_series.hpp"
 
 #include <charconv>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 
+#include "core/error.hpp"
 #include "io/atomic_file.hpp"
 
 namespace domel::platform::io {
@@ -65,6 +68,23 @@ void CsvSeries::append(const std::vector<double>& row) {
   ++pending_;
   dirty_ = true;
   if (pending_ >= flush_every_) flush();
+}
+
+void CsvSeries::resume(std::size_t bytes) {
+  std::ifstream in(path_, std::ios::binary);
+  if (!in) throw RuntimeError("cannot continue '" + path_.string() + "': it cannot be read");
+  std::string old((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (old.size() < bytes)
+    throw RuntimeError("cannot continue '" + path_.string() + "': it holds " + std::to_string(old.size()) +
+                       " bytes, fewer than the " + std::to_string(bytes) + " it had at the checkpoint");
+  if (old.compare(0, text_.size(), text_) != 0)
+    throw RuntimeError("cannot continue '" + path_.string() + "': its header is not this run's (" +
+                       std::to_string(columns_) + " columns)");
+  old.resize(bytes);
+  text_ = std::move(old);
+  pending_ = 0;
+  dirty_ = true;
+  flush();
 }
 
 void CsvSeries::flush() {

@@ -42,6 +42,14 @@ class CsvSeries {
   /// rows stay in memory and the next flush tries again.
   void flush();
 
+  /// Bytes of the file as the last flush() left it (checkpoints).
+  std::size_t size() const { return text_.size(); }
+  /// Continue the series in `path` written by an earlier run (a restart):
+  /// its first `bytes` bytes are kept, from the header on, and later rows
+  /// dropped. Throws RuntimeError when the file is missing, shorter, or has
+  /// another header.
+  void resume(std::size_t bytes);
+
   /// Flushes if anything was never written (including a header-only file
   /// when no row was ever appended); never throws.
   ~CsvSeries();

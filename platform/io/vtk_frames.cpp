@@ -47,11 +47,31 @@ std::string xml_attribute(const std::string& s) {
 VtkFrames::VtkFrames(fs::path directory, std::string basename, std::string extension)
     : directory_(std::move(directory)), basename_(std::move(basename)), extension_(std::move(extension)) {}
 
+std::string VtkFrames::frame_name(std::size_t k) const {
+  char index[32];
+  std::snprintf(index, sizeof index, "%06zu", k);
+  return basename_ + "_" + index + "." + extension_;
+}
+
+std::vector<double> VtkFrames::times() const {
+  std::vector<double> t;
+  for (const Frame& f : frames_) t.push_back(f.time);
+  return t;
+}
+
+void VtkFrames::resume(const std::vector<double>& times) {
+  frames_.clear();
+  for (std::size_t k = 0; k < times.size(); ++k) frames_.push_back(Frame{times[k], frame_name(k)});
+  std::error_code ec;
+  for (std::size_t k = times.size();; ++k) {
+    if (!fs::remove(directory_ / frame_name(k), ec)) break;
+  }
+  write_collection();
+}
+
 fs::path VtkFrames::write(vtkXMLWriter& writer, double time) {
   std::error_code ec;
-  char index[32];
-  std::snprintf(index, sizeof index, "%06zu", frames_.size());
-  const std::string file = basename_ + "_" + index + "." + extension_;
+  const std::string file = frame_name(frames_.size());
   const fs::path target = directory_ / file;
   fs::path tmp = target;
   tmp += ".tmp-" + std::to_string(static_cast<long long>(::getpid()));

@@ -25,6 +25,12 @@ class VtkFrames {
   std::filesystem::path write(vtkXMLWriter& writer, double time);
 
   std::size_t size() const { return frames_.size(); }
+  /// The frames' times, in order (checkpoints).
+  std::vector<double> times() const;
+  /// Continue a series of which the first times.size() frames are on disk
+  /// (a restart): the .pvd is rewritten to list them alone, and frames of a
+  /// later number left by the interrupted run are removed.
+  void resume(const std::vector<double>& times);
   const std::filesystem::path& directory() const { return directory_; }
 
  private:
@@ -33,6 +39,7 @@ class VtkFrames {
     std::string file;  ///< relative to directory_
   };
   void write_collection() const;
+  std::string frame_name(std::size_t k) const;
 
   std::filesystem::path directory_;
   std::string basename_;

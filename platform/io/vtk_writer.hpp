@@ -53,6 +53,9 @@ class VtkSeriesWriter {
 
   /// Number of .vtp files written so far by this writer.
   std::size_t files_written() const { return frames_.size(); }
+  /// Checkpoints: the frames' times, and continuing the series (VtkFrames::resume).
+  std::vector<double> frame_times() const { return frames_.times(); }
+  void resume(const std::vector<double>& times) { frames_.resume(times); }
 
  private:
   std::filesystem::path directory_;

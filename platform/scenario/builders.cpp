@@ -86,6 +86,8 @@ void build_run(Build& b) {
   b.sim.seed = run["seed"].get<std::uint64_t>();
   // no schema default: absent means $DOMEL_THREADS, else 1, decided at run time (Simulation::run)
   b.sim.threads = run.contains("threads") ? run["threads"].get<int>() : 0;
+  b.sim.checkpoint_interval = run["checkpoint_interval"].get<double>();
+  b.sim.document = b.doc;
 }
 
 /// The models of a subdomain's five contact slots (every slot is in the

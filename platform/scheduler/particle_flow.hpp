@@ -31,6 +31,9 @@
 
 namespace domel::platform {
 
+class ArchiveWriter;
+class ArchiveReader;
+
 /// Candidate particles an insertion model placed (parcel radii, alpha applied).
 struct InsertionCandidates {
   std::vector<double> x, y, z, r;
@@ -149,6 +152,14 @@ class ParticleFlow {
   /// inserted - present - removed [kg] of subdomain k: exactly 0 unless a particle was lost or duplicated
   MassUnits residual(std::size_t k, const ParticleStore& s) const;
   const std::vector<MassAccount>& accounts() const { return accounts_; }
+
+  /// Checkpoints: the next id, the books, each pour's progress (its events
+  /// seed its insertions), the deletions' and planes' counts, series and
+  /// sides, the checks' schedule. restore() replaces start() in a restarted
+  /// run and throws ConfigError when the scenario's pours, deletion regions
+  /// or planes are not the checkpoint's.
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void restore(const ArchiveReader& r, const std::string& prefix, std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
  private:
   void pour(Pour& p, double t, Subdomain& sd);

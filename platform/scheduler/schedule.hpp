@@ -59,6 +59,12 @@ class Interval {
     return true;
   }
   double next() const { return next_; }
+  /// Index of the next due time (checkpoints), and going on from one.
+  std::uint64_t index() const { return k_; }
+  void resume(std::uint64_t k) {
+    k_ = k;
+    if (period_ > 0) next_ = first_ + static_cast<double>(k_) * period_;
+  }
   double period() const { return period_; }
   double tolerance() const { return tolerance_; }
 

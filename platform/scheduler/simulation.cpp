@@ -11,6 +11,7 @@
 #include "io/csv_series.hpp"
 #include "io/particle_state.hpp"
 #include "io/vtk_writer.hpp"
+#include "scheduler/checkpoint.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -86,6 +87,21 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   RunResult result;
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
+  // A restart is checked against this scenario before anything is written.
+  std::optional<OpenedCheckpoint> ck;
+  if (!options.restart.empty()) {
+    if (!grid_setups.empty() || !couplings.empty() || fluid)
+      throw ConfigError({Diagnostic{scenario_file.string(), "",
+                                    "a restart does not yet cover cell grids (output.grids), couplings or the fluid "
+                                    "block, whose state checkpoints do not hold yet (docs/checkpoint.md)", ""}});
+    ck = open_checkpoint(options.restart, *this);
+    for (const auto& c : ck->allowed_changes) spdlog::info("restart: scenario changed, allowed: {}", c);
+  }
+  const bool checkpoints_possible = grid_setups.empty() && couplings.empty() && !fluid;
+  if (checkpoint_interval > 0 && !checkpoints_possible)
+    throw ConfigError({Diagnostic{scenario_file.string(), "/run/checkpoint_interval",
+                                  "checkpoints do not yet cover cell grids (output.grids), couplings or the fluid "
+                                  "block (docs/checkpoint.md); remove run.checkpoint_interval", ""}});
   std::filesystem::create_directories(out);
   const int threads_requested =
       options.threads > 0 ? options.threads : (threads > 0 ? threads : default_thread_count());
@@ -103,7 +119,15 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     substeps.push_back(n);
     sd->set_threads(threads_requested);
-    sd->setup();
+    if (!ck) sd->setup();
+  }
+  if (ck) {
+    if (!restore_checkpoint(*ck, *this))
+      spdlog::warn("restart on {} thread(s), the checkpoint was written on {}: the forces are summed in another "
+                   "order, so the run differs from an uninterrupted one by round-off", threads_requested,
+                   ck->loop.threads);
+    spdlog::info("restart from {}: t = {:.6g} s, macro step {}", options.restart.string(), ck->loop.time,
+                 ck->loop.macro_index);
   }
   const std::uint64_t total_macro = static_cast<std::uint64_t>(std::ceil(duration / macro - kTimeTolerance));
 
@@ -118,7 +142,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     columns.push_back(rm.name + ".particles");
   }
   for (const auto& c : flow.columns()) columns.push_back(c);
-  flow.start(subdomains);
+  if (!ck) flow.start(subdomains);
 
   // Cell grids: accessible volume from the walls present at the start.
   grids.clear();
@@ -254,6 +278,44 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
 
   Interval probe_rows(probes ? probe_interval : 0.0, 0.0, macro);
   Interval vtk_frames(vtk ? vtk_interval : 0.0, 0.0, macro);
+  Interval checkpoints(checkpoint_interval, checkpoint_interval, macro);
+  std::uint64_t m = 0;
+  if (ck) {
+    // Go on where the checkpointed run stood: its schedules (re-derived when
+    // an interval changed), its files cut back to what it had written then.
+    m = ck->loop.macro_index;
+    const double t_before = m > 0 ? static_cast<double>(m - 1) * macro : -1.0;
+    auto resume = [&](Interval& iv, std::uint64_t k, double period) {
+      if (period == iv.period()) iv.resume(k);
+      else if (t_before >= 0) iv.advance(t_before);
+    };
+    resume(probe_rows, ck->loop.probe_rows, ck->loop.probe_period);
+    resume(vtk_frames, ck->loop.vtk_frames, ck->loop.vtk_period);
+    resume(checkpoints, ck->loop.checkpoints, checkpoint_interval);
+    if (probes && ck->loop.probe_bytes > 0) probes->resume(ck->loop.probe_bytes);
+    if (vtk) vtk->resume(ck->loop.vtk_times);
+  }
+  const std::uint64_t first_macro = m;
+  auto save_checkpoint = [&](std::uint64_t at) {
+    const auto t0 = std::chrono::steady_clock::now();
+    LoopState ls;
+    ls.macro_index = at;
+    ls.time = static_cast<double>(at) * macro;
+    ls.probe_rows = probe_rows.index();
+    ls.vtk_frames = vtk_frames.index();
+    ls.checkpoints = checkpoints.index();
+    ls.probe_period = probe_rows.period();
+    ls.vtk_period = vtk_frames.period();
+    if (probes) {
+      probes->flush();
+      ls.probe_bytes = probes->size();
+    }
+    if (vtk) ls.vtk_times = vtk->frame_times();
+    ls.threads = threads_requested;
+    write_checkpoint(out / kCheckpointFile, *this, ls, registry);
+    spdlog::debug("checkpoint at t = {:.6g} s written in {:.3g} s", ls.time,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  };
   MacroStep step;  // what the hooks see, updated in place
   step.macro = macro;
   step.subdomains = &subdomains;
@@ -263,10 +325,20 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   double particle_steps = 0;
   double window_particle_steps = 0;
   auto window_start = start;
-  std::uint64_t m = 0;
   const std::uint64_t stop = options.max_steps ? std::min(options.max_steps, total_macro) : total_macro;
+  if (m > stop)
+    throw ConfigError({Diagnostic{scenario_file.string(), "/run",
+                                  "the checkpoint " + options.restart.string() + " is at t = " +
+                                      std::to_string(static_cast<double>(m) * macro) +
+                                      " s, after the end of this run (" + std::to_string(stop * macro) +
+                                      " s); lengthen run.duration", ""}});
   for (;; ++m) {
     const double t = static_cast<double>(m) * macro;
+    // at the start of a macro step, before its hooks and outputs: a restart
+    // begins here, and the last one is at the end of the run
+    if (m > first_macro && checkpoints_possible &&
+        (checkpoints.take(t) || (m == stop && checkpoint_interval > 0)))
+      save_checkpoint(m);
     if (m < stop && !run_hooks.before.empty()) {
       step.t = t;
       step.index = m;

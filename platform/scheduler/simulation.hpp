@@ -32,6 +32,7 @@ struct RunOptions {
   bool progress = true;
   std::uint64_t max_steps = 0;             ///< 0: run to the end; otherwise stop early (smoke tests)
   std::uint64_t time_after = 0;            ///< benchmarks: also time the steps after this many (warm-up excluded)
+  std::filesystem::path restart;           ///< a checkpoint to continue from (docs/checkpoint.md)
 };
 
 struct RunResult {
@@ -68,6 +69,8 @@ class Simulation {
   std::vector<TimeStepReport> time_steps;  ///< per subdomain
   double gravity[3] = {0, 0, 0};  ///< [m/s^2] the scenario's (its schema default when omitted)
   double duration = 0;
+  double checkpoint_interval = 0;  ///< [s] run.checkpoint_interval; 0: none
+  nlohmann::json document;         ///< the validated scenario, defaults filled (checkpoints compare it)
   std::uint64_t seed = 1;
   int threads = 0;  ///< the scenario's run.threads; 0: not given (DOMEL_THREADS, else 1)
   double vtk_interval = 0;

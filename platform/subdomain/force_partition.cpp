@@ -2,6 +2,7 @@
 // The threads' split of a force evaluation (force_partition.hpp).
 #include "subdomain/force_partition.hpp"
 
+#include "core/archive.hpp"
 #include <algorithm>
 #include <iterator>
 
@@ -225,6 +226,53 @@ std::size_t ForcePartition::bytes() const {
     b += (tf.fx.capacity() + tf.fy.capacity() + tf.fz.capacity() + tf.tx.capacity() + tf.ty.capacity() +
           tf.tz.capacity()) * sizeof(double);
   return b;
+}
+
+}  // namespace domel::platform
+
+// ---- checkpoints ----------------------------------------------------------
+
+namespace domel::platform {
+
+void ForcePartition::save(ArchiveWriter& w, const std::string& p) const {
+  w.put_scalar<std::uint64_t>(p + "threads", threads_.size());
+  for (int tier = 0; tier < 2; ++tier) {
+    w.put(p + "split" + std::to_string(tier),
+          std::vector<std::uint64_t>(split_[tier].begin(), split_[tier].end()));
+  }
+  w.put_scalar<std::uint64_t>(p + "split_builds", split_builds_);
+  std::vector<std::uint64_t> spans;
+  for (const ThreadForces& tf : threads_)
+    for (const auto& tier : tf.span) spans.insert(spans.end(), {tier[0], tier[1]});
+  w.put(p + "spans", spans);
+  std::vector<std::uint32_t> wall_particle;
+  std::vector<double> wall_cost;
+  for (const auto& [k, c] : wall_work_) {
+    wall_particle.push_back(k);
+    wall_cost.push_back(c);
+  }
+  w.put(p + "wall_particle", wall_particle);
+  w.put(p + "wall_cost", wall_cost);
+}
+
+void ForcePartition::load(const ArchiveReader& r, const std::string& p) {
+  if (r.scalar<std::uint64_t>(p + "threads") != threads_.size())
+    r.fail(p + "threads", "was written by a run on another thread count");
+  for (int tier = 0; tier < 2; ++tier) {
+    const auto v = r.get<std::uint64_t>(p + "split" + std::to_string(tier));
+    split_[tier].assign(v.begin(), v.end());
+  }
+  split_builds_ = r.scalar<std::uint64_t>(p + "split_builds");
+  const auto spans = r.get<std::uint64_t>(p + "spans");
+  if (spans.size() != 4 * threads_.size()) r.fail(p + "spans", "does not hold 4 values per thread");
+  for (std::size_t t = 0; t < threads_.size(); ++t)
+    for (int tier = 0; tier < 2; ++tier)
+      for (int e = 0; e < 2; ++e) threads_[t].span[tier][e] = spans[4 * t + 2 * tier + e];
+  const auto wall_particle = r.get<std::uint32_t>(p + "wall_particle");
+  const auto wall_cost = r.get<double>(p + "wall_cost");
+  if (wall_particle.size() != wall_cost.size()) r.fail(p + "wall_cost", "disagrees with wall_particle in length");
+  wall_work_.clear();
+  for (std::size_t e = 0; e < wall_particle.size(); ++e) wall_work_.emplace_back(wall_particle[e], wall_cost[e]);
 }
 
 }  // namespace domel::platform

@@ -23,6 +23,9 @@
 
 namespace domel::platform {
 
+class ArchiveWriter;
+class ArchiveReader;
+
 class ForcePartition {
  public:
   /// One thread's private force arrays (threads > 0) and particle spans.
@@ -73,6 +76,13 @@ class ForcePartition {
   }
   /// Add the other threads' private sums of particles [first, last) into the store, in thread order.
   void reduce(ParticleStore& s, std::size_t first, std::size_t last) const;
+
+  /// The split as the next evaluation would find it: the tiers' ranges, the
+  /// build they belong to, the threads' spans and the wall work (checkpoints:
+  /// a restart then sums the forces in the same order). The private force
+  /// arrays are scratch, cleared before each use.
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void load(const ArchiveReader& r, const std::string& prefix);
 
   /// Bytes of the private force arrays.
   std::size_t bytes() const;

@@ -35,6 +35,9 @@
 
 namespace domel::platform {
 
+class ArchiveWriter;
+class ArchiveReader;
+
 class Subdomain {
  public:
   Subdomain(std::string name, double coarse_grain, std::size_t material, std::unique_ptr<ContactPipeline> pipeline);
@@ -110,6 +113,19 @@ class Subdomain {
   /// the complete step; a reference to the store kept from before does not.
   /// With hooks the step completes in phase order (bit-identical results).
   void step_deferred();
+
+  /// Checkpoints: everything the next step depends on, after finishing the
+  /// last one (synchronize(): the fused path's deferred work is done the way
+  /// the next step would do it, so the run goes on bit-identically).
+  void save(ArchiveWriter& w, const std::string& prefix);
+  /// Instead of setup(), once the environment, skin and threads are set: the
+  /// state save() wrote, lists and forces included, so the next step is the
+  /// one the saved run would have taken. Returns false when the threads'
+  /// split could not be restored (another thread count: the forces are then
+  /// summed in another order, and the run differs from the saved one by
+  /// round-off). Throws ConfigError when the checkpoint does not fit this
+  /// subdomain.
+  bool restore(const ArchiveReader& r, const std::string& prefix);
 
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }

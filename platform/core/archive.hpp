@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: MIT
+// The checkpoint file's container (docs/checkpoint.md): a header of JSON
+// (what the run was: scenario, plugins, subdomains, time) and named sections
+// of typed arrays, closed by a checksum, so that a checkpoint is read back
+// bit for bit or refused with a message naming the file and the section.
+// Every class whose state a restart needs writes its own sections, under a
+// prefix ("sd0/", "flow/") chosen by its owner.
+//
+// Layout (little-endian, the only byte order this build runs on):
+//   "DOMELCKP"  magic, 8 bytes
+//   u32         format version (kArchiveVersion)
+//   u32         0x01020304, the byte-order mark
+//   u64 + bytes the header, JSON text
+//   u64         section count
+//   per section: u32 key length, key, u8 type (ArchiveType), u64 element
+//                count, count x element size bytes
+//   u64         FNV-1a 64 of every byte before it
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace domel::platform {
+
+inline constexpr std::uint32_t kArchiveVersion = 1;
+
+enum class ArchiveType : std::uint8_t { f64 = 1, u64 = 2, u32 = 3, u8 = 4, i64 = 5, bytes = 6 };
+
+template <class T>
+constexpr ArchiveType archive_type_of() {
+  if constexpr (std::is_same_v<T, double>) return ArchiveType::f64;
+  else if constexpr (std::is_same_v<T, std::uint64_t>) return ArchiveType::u64;
+  else if constexpr (std::is_same_v<T, std::uint32_t>) return ArchiveType::u32;
+  else if constexpr (std::is_same_v<T, std::uint8_t>) return ArchiveType::u8;
+  else if constexpr (std::is_same_v<T, std::int64_t>) return ArchiveType::i64;
+  else static_assert(sizeof(T) == 0, "no archive type for this element type");
+}
+
+/// Collects sections in memory; write() puts the file in place atomically.
+class ArchiveWriter {
+ public:
+  template <class T>
+  void put(const std::string& key, const std::vector<T>& v) {
+    add(key, archive_type_of<T>(), v.size(), v.data(), v.size() * sizeof(T));
+  }
+  template <class T>
+  void put_scalar(const std::string& key, T value) {
+    add(key, archive_type_of<T>(), 1, &value, sizeof(T));
+  }
+  void put_text(const std::string& key, const std::string& text) {
+    add(key, ArchiveType::bytes, text.size(), text.data(), text.size());
+  }
+  /// Write header and sections to `path` (a temporary name, then renamed).
+  /// Throws RuntimeError naming the path when it cannot be written.
+  void write(const std::filesystem::path& path, const std::string& header_json) const;
+  std::size_t bytes() const;
+
+ private:
+  void add(const std::string& key, ArchiveType type, std::uint64_t count, const void* data, std::size_t bytes);
+  struct Section {
+    ArchiveType type;
+    std::uint64_t count;
+    std::string data;
+  };
+  std::vector<std::pair<std::string, Section>> sections_;
+  std::map<std::string, std::size_t> index_;
+};
+
+/// Reads a whole archive; every failure (not an archive, another format
+/// version, a truncated or corrupted file, a missing section, a section of
+/// another type) throws ConfigError naming the file and the section.
+class ArchiveReader {
+ public:
+  explicit ArchiveReader(const std::filesystem::path& path);
+  const std::string& header() const { return header_; }
+  const std::filesystem::path& path() const { return path_; }
+  bool has(const std::string& key) const { return sections_.count(key) != 0; }
+
+  template <class T>
+  std::vector<T> get(const std::string& key) const {
+    const Section& s = find(key, archive_type_of<T>());
+    std::vector<T> v(s.count);
+    if (s.count) std::memcpy(v.data(), s.data.data(), s.count * sizeof(T));
+    return v;
+  }
+  template <class T>
+  void get_into(const std::string& key, std::vector<T>& v) const {
+    v = get<T>(key);
+  }
+  template <class T>
+  T scalar(const std::string& key) const {
+    const Section& s = find(key, archive_type_of<T>());
+    if (s.count != 1) fail(key, "holds " + std::to_string(s.count) + " values, expected 1");
+    T value;
+    std::memcpy(&value, s.data.data(), sizeof(T));
+    return value;
+  }
+  std::string text(const std::string& key) const { return find(key, ArchiveType::bytes).data; }
+  /// Throws ConfigError naming the file and the section.
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+ private:
+  struct Section {
+    ArchiveType type;
+    std::uint64_t count;
+    std::string data;
+  };
+  const Section& find(const std::string& key, ArchiveType type) const;
+  std::filesystem::path path_;
+  std::string header_;
+  std::map<std::string, Section> sections_;
+};
+
+}  // namespace domel::platform

@@ -1,0 +1,173 @@
+// SPDX-License-Identifier: MIT
+// Writing, opening and restoring checkpoints (checkpoint.hpp).
+#include "scheduler/checkpoint.hpp"
+
+#include "core/error.hpp"
+#include "loader/plugin_registry.hpp"
+#include "scheduler/simulation.hpp"
+
+#include <ctime>
+
+namespace domel::platform {
+
+namespace {
+
+constexpr const char* kFormat = "domel checkpoint";
+
+std::string sd_prefix(std::size_t k) { return "subdomain" + std::to_string(k) + "/"; }
+
+/// Scenario keys whose change leaves the checkpointed state valid: when the
+/// run ends, how often it writes, where, and on how many threads.
+const char* const kSafePrefixes[] = {"/run/duration", "/run/steps", "/run/threads", "/run/checkpoint_interval",
+                                     "/output/vtk_interval", "/output/probe_interval", "/output/state",
+                                     "/output/directory", "/name", "/description", "/$schema"};
+
+bool starts_with_pointer(const std::string& path, const std::string& prefix) {
+  return path == prefix || (path.size() > prefix.size() && path.compare(0, prefix.size(), prefix) == 0 &&
+                            path[prefix.size()] == '/');
+}
+
+/// Keys that decide only the particles a fresh run starts with, which a
+/// restart takes from the checkpoint instead.
+bool initial_particles_only(const std::string& path) {
+  if (path.rfind("/subdomains/", 0) != 0) return false;
+  const auto slash = path.find('/', 12);
+  if (slash == std::string::npos) return false;
+  const std::string rest = path.substr(slash);
+  return starts_with_pointer(rest, "/insert") || starts_with_pointer(rest, "/initial_state");
+}
+
+std::string short_json(const nlohmann::json& j) {
+  std::string s = j.dump();
+  return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+int major_of(const std::string& version) {
+  try {
+    return std::stoi(version);
+  } catch (...) {
+    return -1;
+  }
+}
+
+}  // namespace
+
+void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
+                      const PluginRegistry& registry) {
+  ArchiveWriter w;
+  nlohmann::json header;
+  header["format"] = kFormat;
+  header["domel_version"] = DOMEL_VERSION;
+  header["sdk_abi"] = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR);
+  {
+    const std::time_t t = std::time(nullptr);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+    header["written"] = buf;
+  }
+  header["scenario"] = {{"name", sim.name}, {"file", sim.scenario_file.string()}};
+  header["simulated_time_s"] = loop.time;
+  header["macro_step_index"] = loop.macro_index;
+  header["threads"] = loop.threads;
+  nlohmann::json sds = nlohmann::json::array();
+  for (auto& sd : sim.subdomains)
+    sds.push_back({{"name", sd->name()}, {"coarse_grain", sd->coarse_grain()}, {"particles", sd->size()},
+                   {"steps", sd->steps()}, {"time_step_s", sd->time_step()}});
+  header["subdomains"] = sds;
+  header["models"] = sim.models_used;
+  nlohmann::json libs = nlohmann::json::array();
+  for (const auto& lib : registry.libraries())
+    libs.push_back({{"name", lib.name}, {"version", lib.version},
+                    {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)}});
+  header["plugin_libraries"] = libs;
+  header["document"] = sim.document;
+
+  w.put(std::string("loop/counters"), std::vector<std::uint64_t>{loop.macro_index, loop.probe_rows, loop.vtk_frames,
+                                                                  loop.checkpoints, loop.probe_bytes,
+                                                                  static_cast<std::uint64_t>(loop.threads)});
+  w.put(std::string("loop/reals"), std::vector<double>{loop.time, loop.probe_period, loop.vtk_period});
+  w.put(std::string("loop/vtk_times"), loop.vtk_times);
+  for (std::size_t k = 0; k < sim.subdomains.size(); ++k) sim.subdomains[k]->save(w, sd_prefix(k));
+  sim.flow.save(w, "flow/");
+  w.write(file, header.dump());
+}
+
+OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simulation& sim) {
+  OpenedCheckpoint ck;
+  ck.archive = std::make_unique<ArchiveReader>(file);
+  const ArchiveReader& r = *ck.archive;
+  try {
+    ck.header = nlohmann::json::parse(r.header());
+  } catch (const nlohmann::json::exception&) {
+    r.fail("", "has a header that is not JSON");
+  }
+  if (!ck.header.is_object() || ck.header.value("format", std::string()) != kFormat || !ck.header.contains("document"))
+    r.fail("", "has no domel checkpoint header");
+
+  // The scenario: every change must be one that leaves the state valid.
+  std::vector<Diagnostic> refused;
+  const nlohmann::json patch = nlohmann::json::diff(ck.header["document"], sim.document);
+  for (const auto& op : patch) {
+    const std::string path = op["path"].get<std::string>();
+    const nlohmann::json::json_pointer ptr(path);
+    const std::string was = ck.header["document"].contains(ptr) ? short_json(ck.header["document"][ptr]) : "(absent)";
+    const std::string now = sim.document.contains(ptr) ? short_json(sim.document[ptr]) : "(absent)";
+    bool safe = false;
+    for (const char* p : kSafePrefixes) safe = safe || starts_with_pointer(path, p);
+    if (safe) {
+      ck.allowed_changes.push_back(path + ": " + was + " -> " + now);
+    } else if (initial_particles_only(path)) {
+      ck.allowed_changes.push_back(path + ": " + was + " -> " + now + " (ignored: the particles come from the checkpoint)");
+    } else {
+      refused.push_back(Diagnostic{sim.scenario_file.string(), path,
+                                   "differs from the checkpointed run's scenario (" + file.string() + "): it was " +
+                                       was + ", now " + now + "; a restart may change only the end time, output "
+                                       "intervals, output folder, threads and checkpoint interval",
+                                   ""});
+    }
+  }
+  // The plugins: the same model, of the same major version, in every slot.
+  const nlohmann::json& was_models = ck.header["models"];
+  for (const auto& [sd, slots] : sim.models_used.items()) {
+    if (!slots.is_object()) continue;
+    for (const auto& [slot, m] : slots.items()) {
+      if (!was_models.contains(sd) || !was_models[sd].contains(slot)) continue;  // a scenario change, reported above
+      const auto& old = was_models[sd][slot];
+      const std::string old_v = old.value("version", std::string()), new_v = m.value("version", std::string());
+      if (major_of(old_v) != major_of(new_v))
+        refused.push_back(Diagnostic{sim.scenario_file.string(), "",
+                                     "subdomain '" + sd + "', " + slot + " model '" + m.value("model", std::string()) +
+                                         "': the checkpoint was written with version " + old_v + ", this run loads " +
+                                         new_v + " (another major version may keep other state)",
+                                     ""});
+      else if (old_v != new_v)
+        ck.allowed_changes.push_back("subdomain '" + sd + "', " + slot + " model version " + old_v + " -> " + new_v);
+    }
+  }
+  if (!refused.empty()) throw ConfigError(refused);
+
+  const auto c = r.get<std::uint64_t>("loop/counters");
+  const auto reals = r.get<double>("loop/reals");
+  if (c.size() != 6 || reals.size() != 3) r.fail("loop/counters", "does not hold the run loop's state");
+  ck.loop.macro_index = c[0];
+  ck.loop.probe_rows = c[1];
+  ck.loop.vtk_frames = c[2];
+  ck.loop.checkpoints = c[3];
+  ck.loop.probe_bytes = c[4];
+  ck.loop.threads = static_cast<int>(c[5]);
+  ck.loop.time = reals[0];
+  ck.loop.probe_period = reals[1];
+  ck.loop.vtk_period = reals[2];
+  ck.loop.vtk_times = r.get<double>("loop/vtk_times");
+  return ck;
+}
+
+bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim) {
+  bool same_split = true;
+  for (std::size_t k = 0; k < sim.subdomains.size(); ++k)
+    same_split = sim.subdomains[k]->restore(*ck.archive, sd_prefix(k)) && same_split;
+  sim.flow.restore(*ck.archive, "flow/", sim.subdomains);
+  return same_split;
+}
+
+}  // namespace domel::platform

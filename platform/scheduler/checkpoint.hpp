@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+// Checkpoints of a run (docs/checkpoint.md): what the run loop itself keeps
+// (the macro step reached, the output schedules, how far its files got), the
+// header that says which run wrote the file, and the comparison of a
+// restarted run's scenario with the checkpointed one: changes that cannot
+// alter the state are listed, the others refused with their JSON pointer.
+#pragma once
+
+#include "core/archive.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace domel::platform {
+
+class Simulation;
+class PluginRegistry;
+
+/// The checkpoint file's name in the output folder.
+inline constexpr const char* kCheckpointFile = "checkpoint.ckpt";
+
+/// The run loop's state at the start of macro step `macro_index`, before
+/// its hooks and outputs.
+struct LoopState {
+  std::uint64_t macro_index = 0;
+  double time = 0;                   ///< [s] macro_index x macro step
+  std::uint64_t probe_rows = 0;      ///< Interval indices (schedule.hpp)
+  std::uint64_t vtk_frames = 0;
+  std::uint64_t checkpoints = 0;
+  double probe_period = 0, vtk_period = 0;  ///< the periods those indices count
+  std::uint64_t probe_bytes = 0;     ///< probes.csv's length after its last flush
+  std::vector<double> vtk_times;     ///< frames of particles.pvd
+  int threads = 1;
+};
+
+/// Write `file` atomically: the header, the loop state, every subdomain and
+/// the particle flow. Finishes every subdomain's pending step first.
+void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
+                      const PluginRegistry& registry);
+
+/// A checkpoint opened for a restart and checked against the scenario.
+struct OpenedCheckpoint {
+  std::unique_ptr<ArchiveReader> archive;
+  LoopState loop;
+  nlohmann::json header;
+  std::vector<std::string> allowed_changes;  ///< "pointer: old -> new", safe ones
+};
+
+/// Open `file` and compare it with `sim` (built from the scenario to run):
+/// throws ConfigError naming the file and every difference that would make
+/// the checkpoint's state wrong for this scenario (another material, contact
+/// model or plugin major version, coarse-grain ratio, time step, walls,
+/// pours ...). Changes of the end time, output intervals, threads, output
+/// folder and checkpoint interval are allowed and listed.
+OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simulation& sim);
+
+/// Restore every subdomain and the particle flow from an opened checkpoint
+/// (instead of Subdomain::setup() and ParticleFlow::start()). Returns false
+/// when some subdomain's thread split could not be restored (another thread
+/// count): the run then differs from the uninterrupted one by round-off.
+bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim);
+
+}  // namespace domel::platform
