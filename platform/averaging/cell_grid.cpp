@@ -5,6 +5,8 @@
 // Formulas: docs/physics.md §5.2 and §8; choices: docs/averaging.md.
 #include "averaging/cell_grid.hpp"
 
+#include "core/archive.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -341,6 +343,35 @@ LayerProfile CellGrid::profile(const CellFields& f, int axis) const {
     }
   }
   return p;
+}
+
+void CellGrid::save(ArchiveWriter& w, const std::string& p) const {
+  w.put(p + "accessible", accessible_);
+  for (const auto& [which, fields] : {std::pair<const char*, const CellFields*>{"latest/", &latest_}, {"sum/", &sum_}}) {
+    const_cast<CellFields*>(fields)->for_each_field(
+        [&](const char* name, const std::vector<double>& v) { w.put(p + which + name, v); });
+    w.put(p + which + "time_samples", std::vector<double>{fields->time, static_cast<double>(fields->samples)});
+  }
+  w.put_scalar<std::uint64_t>(p + "pending", pending_);
+}
+
+void CellGrid::load(const ArchiveReader& r, const std::string& p) {
+  r.get_into(p + "accessible", accessible_);
+  if (accessible_.size() != n_cells_)
+    r.fail(p + "accessible", "holds a grid of " + std::to_string(accessible_.size()) + " cells; cell grid '" +
+                                 spec_.name + "' has " + std::to_string(n_cells_));
+  for (const auto& [which, fields] : {std::pair<const char*, CellFields*>{"latest/", &latest_}, {"sum/", &sum_}}) {
+    fields->for_each_field([&](const char* name, std::vector<double>& v) {
+      r.get_into(p + which + name, v);
+      if (!v.empty() && v.size() != n_cells_ && v.size() != 9 * n_cells_)
+        r.fail(p + which + name, "does not hold one value (or nine) per cell");
+    });
+    const auto ts = r.get<double>(p + which + "time_samples");
+    if (ts.size() != 2) r.fail(p + which + "time_samples", "does not hold a time and a sample count");
+    fields->time = ts[0];
+    fields->samples = static_cast<std::size_t>(ts[1]);
+  }
+  pending_ = r.scalar<std::uint64_t>(p + "pending");
 }
 
 }  // namespace domel::platform

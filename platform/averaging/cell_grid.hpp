@@ -22,6 +22,9 @@
 
 namespace domel::platform {
 
+class ArchiveWriter;
+class ArchiveReader;
+
 /// One contact force, recorded during a force evaluation on sampling steps.
 /// A pair appears once (either orientation); i and j index the same
 /// ParticleStore that is passed to CellGrid::sample().
@@ -71,6 +74,17 @@ struct CellFields {
 
   /// Resize every vector for `n` cells and set all values to 0.
   void reset(std::size_t n);
+  /// Every per-cell vector with its name (checkpoints).
+  template <class F>
+  void for_each_field(F&& f) {
+    const std::pair<const char*, std::vector<double>*> all[] = {
+        {"count", &count}, {"count_fixed", &count_fixed}, {"mass", &mass}, {"mobile_mass", &mobile_mass},
+        {"volume_fraction", &volume_fraction}, {"vx", &vx}, {"vy", &vy}, {"vz", &vz}, {"vmin_x", &vmin_x},
+        {"vmin_y", &vmin_y}, {"vmin_z", &vmin_z}, {"vmax_x", &vmax_x}, {"vmax_y", &vmax_y}, {"vmax_z", &vmax_z},
+        {"pressure", &pressure}, {"accessible", &accessible}, {"stress", &stress},
+        {"stress_kinetic", &stress_kinetic}};
+    for (const auto& [name, v] : all) f(name, *v);
+  }
 };
 
 /// A field set reduced to layers along one axis ("pressure over height").
@@ -156,6 +170,12 @@ class CellGrid {
   /// Layer profile of `f` along `axis` (0, 1, 2); see LayerProfile. Throws
   /// std::invalid_argument for another axis or a field set of the wrong size.
   LayerProfile profile(const CellFields& f, int axis = 2) const;
+
+  /// Checkpoints: the accessible volume, the last sample and the running
+  /// sums since the last take. load() throws ConfigError when the
+  /// checkpoint's grid has another cell count.
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void load(const ArchiveReader& r, const std::string& prefix);
 
  private:
   CellGridSpec spec_;

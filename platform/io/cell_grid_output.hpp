@@ -40,6 +40,9 @@ class CellGridVtkSeries {
   std::filesystem::path write(double time, const CellGrid& grid, const CellFields& f);
 
   std::size_t files_written() const { return frames_.size(); }
+  /// Checkpoints: the frames' times, and continuing the series (VtkFrames::resume).
+  std::vector<double> frame_times() const { return frames_.times(); }
+  void resume(const std::vector<double>& times) { frames_.resume(times); }
 
  private:
   std::filesystem::path directory_;
@@ -91,6 +94,9 @@ class CellGridProfileCsv {
   void write(double time, const CellGrid& grid, const CellFields& f);
 
   const std::filesystem::path& path() const { return path_; }
+  /// Checkpoints: the file's length, and continuing it (CsvSeries::resume).
+  std::size_t size() const { return csv_.size(); }
+  void resume(std::size_t bytes) { csv_.resume(bytes); }
 
  private:
   std::filesystem::path directory_;

@@ -53,7 +53,7 @@ int major_of(const std::string& version) {
 }  // namespace
 
 void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
-                      const PluginRegistry& registry) {
+                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra) {
   ArchiveWriter w;
   nlohmann::json header;
   header["format"] = kFormat;
@@ -89,6 +89,7 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
   w.put(std::string("loop/vtk_times"), loop.vtk_times);
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k) sim.subdomains[k]->save(w, sd_prefix(k));
   sim.flow.save(w, "flow/");
+  if (extra) extra(w);
   w.write(file, header.dump());
 }
 

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -40,8 +41,9 @@ struct LoopState {
 
 /// Write `file` atomically: the header, the loop state, every subdomain and
 /// the particle flow. Finishes every subdomain's pending step first.
+/// `extra` adds the sections of what the run loop owns (cell grids and their files).
 void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
-                      const PluginRegistry& registry);
+                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra = {});
 
 /// A checkpoint opened for a restart and checked against the scenario.
 struct OpenedCheckpoint {

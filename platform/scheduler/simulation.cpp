@@ -90,18 +90,18 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   // A restart is checked against this scenario before anything is written.
   std::optional<OpenedCheckpoint> ck;
   if (!options.restart.empty()) {
-    if (!grid_setups.empty() || !couplings.empty() || fluid)
+    if (!couplings.empty() || fluid)
       throw ConfigError({Diagnostic{scenario_file.string(), "",
-                                    "a restart does not yet cover cell grids (output.grids), couplings or the fluid "
-                                    "block, whose state checkpoints do not hold yet (docs/checkpoint.md)", ""}});
+                                    "a restart does not yet cover couplings or the fluid block, whose state "
+                                    "checkpoints do not hold yet (docs/checkpoint.md)", ""}});
     ck = open_checkpoint(options.restart, *this);
     for (const auto& c : ck->allowed_changes) spdlog::info("restart: scenario changed, allowed: {}", c);
   }
-  const bool checkpoints_possible = grid_setups.empty() && couplings.empty() && !fluid;
+  const bool checkpoints_possible = couplings.empty() && !fluid;
   if (checkpoint_interval > 0 && !checkpoints_possible)
     throw ConfigError({Diagnostic{scenario_file.string(), "/run/checkpoint_interval",
-                                  "checkpoints do not yet cover cell grids (output.grids), couplings or the fluid "
-                                  "block (docs/checkpoint.md); remove run.checkpoint_interval", ""}});
+                                  "checkpoints do not yet cover couplings or the fluid block (docs/checkpoint.md); "
+                                  "remove run.checkpoint_interval", ""}});
   std::filesystem::create_directories(out);
   const int threads_requested =
       options.threads > 0 ? options.threads : (threads > 0 ? threads : default_thread_count());
@@ -294,6 +294,20 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     resume(checkpoints, ck->loop.checkpoints, checkpoint_interval);
     if (probes && ck->loop.probe_bytes > 0) probes->resume(ck->loop.probe_bytes);
     if (vtk) vtk->resume(ck->loop.vtk_times);
+    const ArchiveReader& r = *ck->archive;
+    for (std::size_t g = 0; g < grids.size(); ++g) {
+      const std::string p = "grid" + std::to_string(g) + "/";
+      grids[g]->load(r, p);
+      const auto files = r.get<std::uint64_t>(p + "files");
+      if (files.size() != 2) r.fail(p + "files", "does not hold a grid's file state");
+      resume(grid_files[g], files[0], r.scalar<double>(p + "write_interval"));
+      if (grid_vtk[g]) {
+        grid_vtk[g]->resume(r.get<double>(p + "vtk_times"));
+        if (files[1] > 0) grid_csv[g]->resume(files[1]);
+      }
+    }
+    // the walls' activity as the run last looked at it (refresh_accessible)
+    for (std::size_t w = 0; w < walls.size(); ++w) wall_active[w] = walls[w].active(t_before >= 0 ? t_before : 0.0) ? 1 : 0;
   }
   const std::uint64_t first_macro = m;
   auto save_checkpoint = [&](std::uint64_t at) {
@@ -312,7 +326,15 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     if (vtk) ls.vtk_times = vtk->frame_times();
     ls.threads = threads_requested;
-    write_checkpoint(out / kCheckpointFile, *this, ls, registry);
+    write_checkpoint(out / kCheckpointFile, *this, ls, registry, [&](ArchiveWriter& w) {
+      for (std::size_t g = 0; g < grids.size(); ++g) {
+        const std::string p = "grid" + std::to_string(g) + "/";
+        grids[g]->save(w, p);
+        w.put(p + "files", std::vector<std::uint64_t>{grid_files[g].index(), grid_csv[g] ? grid_csv[g]->size() : 0u});
+        w.put_scalar(p + "write_interval", grid_files[g].period());
+        w.put(p + "vtk_times", grid_vtk[g] ? grid_vtk[g]->frame_times() : std::vector<double>{});
+      }
+    });
     spdlog::debug("checkpoint at t = {:.6g} s written in {:.3g} s", ls.time,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   };
