@@ -6,6 +6,7 @@
 // refused, 64 wrong command-line usage.
 #include "apps/compare.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "io/atomic_file.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scenario/reference.hpp"
@@ -14,11 +15,14 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <map>
 #include <optional>
 #include <thread>
+
+#include <unistd.h>
 
 namespace dp = domel::platform;
 
@@ -147,8 +151,28 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
   }
 }
 
+/// SIGINT and SIGTERM ask the run to stop after its current step
+/// (core/interrupt.hpp); a second one ends the process at once (the handler
+/// resets itself).
+extern "C" void on_stop_signal(int sig) {
+  dp::request_interrupt(sig);
+  const char msg[] = "\ndomel: stopping after this step, writing a checkpoint and the outputs (again to quit at once)\n";
+  const ssize_t ignored = ::write(2, msg, sizeof msg - 1);
+  (void)ignored;
+}
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
 int cmd_run(int argc, char** argv) {
-  const Args a = parse(argc, argv, 2, {"--out", "--threads", "--max-steps", "--time-after", "--restart"},
+  const Args a = parse(argc, argv, 2,
+                       {"--out", "--threads", "--max-steps", "--time-after", "--restart", "--checkpoint-on-signal"},
                        {"--quiet", "--verbose"});
   if (a.positional.size() != 1) throw UsageError("run expects one scenario file");
   check_thread_environment();
@@ -163,6 +187,10 @@ int cmd_run(int argc, char** argv) {
     opt.restart = *r;
     // a restart continues the checkpointed run's files, in its folder
     if (opt.output_directory.empty()) opt.output_directory = opt.restart.parent_path().empty() ? "." : opt.restart.parent_path();
+  }
+  if (auto c = a.option("--checkpoint-on-signal")) {
+    if (*c != "on" && *c != "off") throw UsageError("--checkpoint-on-signal expects on or off, found '" + *c + "'");
+    opt.checkpoint_on_signal = *c == "on";
   }
   opt.progress = !a.flag("--quiet");
 
@@ -179,6 +207,7 @@ int cmd_run(int argc, char** argv) {
   try {
     dp::RunResult result;
     try {
+      install_stop_handlers();
       result = sim->run(opt, registry);
     } catch (const dp::ConfigError& e) {
       print_diagnostics(a.positional[0], e.diagnostics());
@@ -188,6 +217,15 @@ int cmd_run(int argc, char** argv) {
     std::printf("%s: %llu steps, %.6g s simulated, %.3g s wall, %.3g particle-steps/s; output in %s\n",
                 sim->name.c_str(), static_cast<unsigned long long>(result.macro_steps), result.simulated_time,
                 result.wall_seconds, result.particle_steps_per_second, result.output_directory.string().c_str());
+    if (result.interrupted_by) {
+      const bool ck = result.summary.contains("checkpoint");
+      std::fprintf(stderr, "domel: interrupted at t = %.6g s; %s\n", result.simulated_time,
+                   ck ? ("continue with: domel run " + a.positional[0] + " --restart " +
+                         (result.output_directory / result.summary["checkpoint"].get<std::string>()).string())
+                            .c_str()
+                      : "no checkpoint was written");
+      return 128 + result.interrupted_by;  // the shell's convention: 130 for SIGINT, 143 for SIGTERM
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "domel: the run of %s failed: %s\nFiles written before the failure are complete; "
                          "summary.json was not written.\n", a.positional[0].c_str(), e.what());

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // A CSV time series (energies, forces on walls, timings ...) that a plotting
-// script can read at any moment during a run: the whole text is kept in
-// memory and the file is rewritten atomically on flush, so a reader never
-// sees a half-written row. Numbers are written in the shortest form that reads
-// back to the identical double (std::to_chars), so nothing is lost and rows
-// stay short.
+// script can read at any moment during a run: the header is written with the
+// first flush (atomically, so the file never exists without it), later rows
+// are appended in whole lines, one write per flush, so a long run costs
+// O(rows) and never rewrites what is on disk. Numbers are written in the
+// shortest form that reads back to the identical double (std::to_chars), so
+// nothing is lost and rows stay short.
 #pragma once
 
 #include <cstddef>
@@ -14,13 +15,12 @@
 
 namespace domel::platform::io {
 
-/// A CSV time series (header line + one row per append) that appears whole:
-/// rows are buffered and the whole file is rewritten atomically by flush(),
-/// which append() calls automatically when at least `flush_every` rows are
-/// pending; the destructor flushes and never throws (a failure there is
-/// swallowed silently). The parent directory of `path` must exist when the
-/// file is first flushed. Column names containing ',', '"' or a line break are
-/// quoted as in RFC 4180.
+/// A CSV time series (header line + one row per append): rows are buffered
+/// and appended to the file by flush(), which append() calls automatically
+/// when at least `flush_every` rows are pending; the destructor flushes and
+/// never throws (a failure there is swallowed silently). The parent
+/// directory of `path` must exist when the file is first flushed. Column
+/// names containing ',', '"' or a line break are quoted as in RFC 4180.
 class CsvSeries {
  public:
   /// Throws std::invalid_argument if `columns` is empty. Touches no file.
@@ -37,16 +37,16 @@ class CsvSeries {
   /// is not recorded then. May throw RuntimeError from an automatic flush.
   void append(const std::vector<double>& row);
 
-  /// Rewrite the whole file (header and every row so far) atomically, even
-  /// when no row is pending. Throws RuntimeError if it cannot be written; the
-  /// rows stay in memory and the next flush tries again.
+  /// Put every pending row in the file (the first flush creates it with its
+  /// header, even when no row is pending). Throws RuntimeError if it cannot
+  /// be written; the rows stay pending and the next flush tries again.
   void flush();
 
-  /// Bytes of the file as the last flush() left it (checkpoints).
-  std::size_t size() const { return text_.size(); }
+  /// Bytes in the file after the last flush (checkpoints).
+  std::size_t size() const { return written_; }
   /// Continue the series in `path` written by an earlier run (a restart):
   /// its first `bytes` bytes are kept, from the header on, and later rows
-  /// dropped. Throws RuntimeError when the file is missing, shorter, or has
+  /// cut off. Throws RuntimeError when the file is missing, shorter, or has
   /// another header.
   void resume(std::size_t bytes);
 
@@ -58,9 +58,12 @@ class CsvSeries {
   std::filesystem::path path_;
   std::size_t columns_;
   std::size_t flush_every_;
-  std::string text_;          ///< header + all rows, exactly the file contents
-  std::size_t pending_ = 0;   ///< rows appended since the last successful flush
-  bool dirty_ = true;         ///< file missing or out of date
+  std::string header_;         ///< the header line
+  std::string pending_text_;   ///< rows appended since the last successful flush
+  std::size_t pending_ = 0;    ///< their count
+  std::size_t written_ = 0;    ///< bytes in the file
+  bool created_ = false;       ///< the file exists with its header
+  bool active_ = true;         ///< false once moved from
 };
 
 }  // namespace domel::platform::io

@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "geometry/region.hpp"
 #include "io/atomic_file.hpp"
 #include "io/cell_grid_output.hpp"
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cctype>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -268,6 +270,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     for (std::size_t k = 0; k < subdomains.size(); ++k)
       sets.push_back({&subdomains[k]->store(), static_cast<int>(k)});
     vtk->write(t, sets);
+    if (probes) probes->flush();  // probes.csv reaches the frame just written
   };
 
   std::size_t particles = 0;
@@ -361,6 +364,14 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (m > first_macro && checkpoints_possible &&
         (checkpoints.take(t) || (m == stop && checkpoint_interval > 0)))
       save_checkpoint(m);
+    if (m < stop && (result.interrupted_by = interrupt_requested()) != 0) {
+      // a signal: the last step is complete; the checkpoint holds it, and
+      // probes.csv and the other files end where the checkpoint does
+      if (options.checkpoint_on_signal && checkpoints_possible) save_checkpoint(m);
+      else if (options.checkpoint_on_signal)
+        spdlog::warn("no checkpoint: checkpoints do not yet cover couplings or the fluid block");
+      break;
+    }
     if (m < stop && !run_hooks.before.empty()) {
       step.t = t;
       step.index = m;
@@ -419,6 +430,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   summary["domel_version"] = DOMEL_VERSION;
   summary["sdk_abi"] = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR);
   summary["scenario"] = {{"name", name}, {"file", scenario_file.string()}};
+  summary["status"] = result.interrupted_by ? "interrupted" : "completed";
+  if (result.interrupted_by) {
+    summary["signal"] = result.interrupted_by == SIGINT ? "SIGINT" : result.interrupted_by == SIGTERM ? "SIGTERM"
+                                                                                                  : std::to_string(result.interrupted_by);
+    if (options.checkpoint_on_signal && checkpoints_possible) summary["checkpoint"] = kCheckpointFile;
+  }
+  if (ck) summary["restarted_from"] = {{"checkpoint", options.restart.string()}, {"simulated_time_s", ck->loop.time}};
   summary["finished"] = iso_time_now();
   summary["threads"] = threads_requested;
   summary["seed"] = seed;

@@ -33,6 +33,7 @@ struct RunOptions {
   std::uint64_t max_steps = 0;             ///< 0: run to the end; otherwise stop early (smoke tests)
   std::uint64_t time_after = 0;            ///< benchmarks: also time the steps after this many (warm-up excluded)
   std::filesystem::path restart;           ///< a checkpoint to continue from (docs/checkpoint.md)
+  bool checkpoint_on_signal = true;        ///< on SIGINT/SIGTERM (core/interrupt.hpp), write a checkpoint
 };
 
 struct RunResult {
@@ -42,6 +43,7 @@ struct RunResult {
   double particle_steps_per_second = 0;
   std::filesystem::path output_directory;
   nlohmann::json summary;
+  int interrupted_by = 0;  ///< the signal that stopped the run early (core/interrupt.hpp), 0 if none
 };
 
 /// output.region_mass: the mass of the particles inside a region (a heap on

@@ -4,6 +4,7 @@
 // .pvd index) and the CSV time series. Every test works in its own fresh
 // temporary directory and removes it afterwards.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <chrono>
@@ -350,6 +351,41 @@ TEST(IoCsvSeries, DestructorNeverThrows) {
     csv.append({1.0});
   });
   EXPECT_FALSE(fs::exists(p));
+}
+
+// Guards that flushes after the first append to the file (the same file, not
+// a rewritten copy), and that a restart's resume() cuts the file back to a
+// checkpoint's length and refuses a file of another header.
+TEST(IoCsvSeries, AppendsAndResumes) {
+  TempDir dir;
+  const fs::path p = dir.path() / "a.csv";
+  std::size_t at_checkpoint = 0;
+  {
+    CsvSeries csv(p, {"t", "x"}, 1);
+    csv.append({1, 10});
+    struct stat before {};
+    ASSERT_EQ(::stat(p.c_str(), &before), 0);
+    at_checkpoint = csv.size();
+    csv.append({2, 20});
+    csv.append({3, 30});
+    struct stat after {};
+    ASSERT_EQ(::stat(p.c_str(), &after), 0);
+    EXPECT_EQ(before.st_ino, after.st_ino) << "the file was replaced, not appended to";
+    EXPECT_EQ(read_all(p), "t,x\n1,10\n2,20\n3,30\n");
+    EXPECT_EQ(csv.size(), read_all(p).size());
+  }
+  {
+    CsvSeries csv(p, {"t", "x"}, 1);
+    csv.resume(at_checkpoint);
+    EXPECT_EQ(read_all(p), "t,x\n1,10\n");
+    csv.append({2, 21});
+    EXPECT_EQ(read_all(p), "t,x\n1,10\n2,21\n");
+  }
+  CsvSeries other(p, {"t", "y"});
+  EXPECT_THROW(other.resume(at_checkpoint), domel::platform::RuntimeError);
+  CsvSeries longer(p, {"t", "x"});
+  EXPECT_THROW(longer.resume(1000), domel::platform::RuntimeError);
+  EXPECT_TRUE(temp_files_in(dir.path()).empty());
 }
 
 // Guards that a row of the wrong width throws and is not recorded.
