@@ -152,6 +152,7 @@ def run_callgrind_case(binary, which, case, n, nsteps, workdir, timeout, env, va
     cg_out = outdir + ".callgrind.out"
     row = {"mode": "callgrind", "case": case, "N_requested": n, "threads": 1, "binary": which, "rep": 1,
            "steps": nsteps, "log": log, "load1_start": run_s1.load1()}
+    shutil.rmtree(outdir, ignore_errors=True)  # a fresh folder (domel refuses one with an earlier run's output)
     cmd = [valgrind, "--tool=callgrind", "--callgrind-out-file=" + cg_out, binary, "run", scen, "--out", outdir,
            "--quiet", "--threads", "1", "--max-steps", str(nsteps)]
     rc, wall, cpu, _ = run_s1.run_timed(cmd, wd, log, timeout, env, sample_s=0.2)

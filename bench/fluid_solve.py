@@ -12,7 +12,7 @@ keeps the time per cell about constant as the grid grows; a preconditioned
 conjugate gradient does not (its iterations grow with the grid's width).
 Both pressure solves are measured ("solver": {"backend": "cg" | "pfmg"}).
 Usage: bench/fluid_solve.py [--domel build/bin/domel] [--reps 3] [--backends cg,pfmg]"""
-import argparse, json, os, statistics, subprocess, sys, tempfile
+import argparse, json, os, shutil, statistics, subprocess, sys, tempfile
 
 GRIDS = [(8, 8, 40), (16, 16, 80), (32, 32, 160)]
 
@@ -54,6 +54,7 @@ def main():
             times, iters = [], 0
             for r in range(args.reps):
                 out = os.path.join(tmp, "out")
+                shutil.rmtree(out, ignore_errors=True)  # domel refuses a folder with an earlier run's output
                 subprocess.run([args.domel, "run", f, "--out", out, "--quiet", "--threads", "1"], check=True,
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
                 fl = json.load(open(os.path.join(out, "summary.json")))["fluid"]

@@ -34,6 +34,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 
@@ -160,6 +161,7 @@ def prepare(n, workdir, domel, threads=2, log=print):
         f.write(make_s1.dumps(scen) + "\n")
     out = os.path.join(workdir, scen["name"] + "_out")
     log("preparing the bed for N = %d: %d steps of domel (%s) ..." % (n, scen["run"]["steps"], spath))
+    shutil.rmtree(out, ignore_errors=True)  # domel refuses a folder with an earlier run's output
     subprocess.run([domel, "run", spath, "--out", out, "--quiet", "--threads", str(threads)], check=True)
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)

@@ -241,6 +241,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
     log = outdir + ".screen"
     row = {"code": code, "N_requested": n, "rep": rep, "log": log}
     row["load1_start"] = load1()
+    shutil.rmtree(outdir, ignore_errors=True)  # a fresh folder (domel refuses one with an earlier run's output)
     rc, wall, cpu, samples = run_timed([domel, "run", scen, "--out", outdir, "--quiet",
                                "--time-after", str(nsettle), "--threads", str(threads)], workdir, log, timeout, env)
     row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)

@@ -3,6 +3,7 @@
 #include "apps/compare.hpp"
 
 #include "core/error.hpp"
+#include "io/output_folder.hpp"
 #include "io/atomic_file.hpp"
 #include "scenario/scenario.hpp"
 
@@ -204,6 +205,9 @@ std::filesystem::path run_compare(const CompareOptions& options, PluginRegistry&
   }
 
   const std::filesystem::path out = options.output_directory;
+  // a comparison run again replaces its variants' earlier runs (their
+  // manifests say which files; io/output_folder.hpp), checked before any runs
+  for (const auto& v : options.variants) io::prepare_output_folder(out / slug(v.label), io::OutputPolicy::overwrite);
   std::filesystem::create_directories(out);
   std::vector<std::filesystem::path> dirs;
   std::vector<json> summaries;

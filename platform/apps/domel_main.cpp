@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "io/atomic_file.hpp"
+#include "io/output_folder.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scenario/reference.hpp"
 #include "scenario/scenario.hpp"
@@ -35,14 +36,17 @@ constexpr int kExitUsage = 64;
 const char* kUsage = R"(usage: domel <command> [options]
 
 commands:
-  run FILE [--out DIR] [--threads N] [--max-steps N] [--time-after N] [--restart CHECKPOINT]
-      [--quiet] [--verbose]
+  run FILE [--out DIR] [--overwrite] [--threads N] [--max-steps N] [--time-after N]
+      [--restart CHECKPOINT] [--checkpoint-on-signal on|off] [--quiet] [--verbose]
                       validate and run a scenario; writes particles_*.vtp + particles.pvd
                       (ParaView), probes.csv and summary.json into the output folder.
                       --max-steps stops early; --time-after N also reports the speed of
                       the steps after the first N (benchmarks, in summary.json);
                       --restart continues the run that wrote CHECKPOINT (run.checkpoint_interval)
-                      in its folder, bit-identically on the same thread count
+                      in its folder, bit-identically on the same thread count; a folder that
+                      holds an earlier run's output is refused unless --overwrite, which
+                      removes the files that run listed in domel_manifest.txt. SIGINT/SIGTERM
+                      finish the step and write a checkpoint (unless --checkpoint-on-signal off)
   compare FILE --vary POINTER=VALUE[;POINTER=VALUE...] [--vary ...] [--label NAME ...]
           [--out DIR] [--threads N] [--max-steps N]
                       run variants of one scenario (same seeds and insertion) and write
@@ -145,7 +149,9 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
   for (const auto& d : diags) {
     // a problem in another file (a checkpoint, a state file) names it
     const std::string in = !d.file.empty() && d.file != what ? d.file + ", " : "";
-    std::string line = "  - " + in + "at " + (d.pointer.empty() ? std::string("/") : d.pointer) + ": " + d.message;
+    std::string line = !in.empty() && d.pointer.empty()
+                           ? "  - " + d.file + ": " + d.message
+                           : "  - " + in + "at " + (d.pointer.empty() ? std::string("/") : d.pointer) + ": " + d.message;
     if (!d.hint.empty()) line += " (" + d.hint + ")";
     std::fprintf(stderr, "%s\n", line.c_str());
   }
@@ -173,8 +179,10 @@ void install_stop_handlers() {
 int cmd_run(int argc, char** argv) {
   const Args a = parse(argc, argv, 2,
                        {"--out", "--threads", "--max-steps", "--time-after", "--restart", "--checkpoint-on-signal"},
-                       {"--quiet", "--verbose"});
+                       {"--quiet", "--verbose", "--overwrite"});
   if (a.positional.size() != 1) throw UsageError("run expects one scenario file");
+  if (a.flag("--overwrite") && a.option("--restart"))
+    throw UsageError("--overwrite and --restart exclude each other: a restart continues its folder's files");
   check_thread_environment();
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
   if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
@@ -207,6 +215,11 @@ int cmd_run(int argc, char** argv) {
   try {
     dp::RunResult result;
     try {
+      // an earlier run's files are neither mixed with this run's nor removed unasked
+      dp::io::prepare_output_folder(opt.output_directory.empty() ? sim->output_directory : opt.output_directory,
+                                    !opt.restart.empty()   ? dp::io::OutputPolicy::restart
+                                    : a.flag("--overwrite") ? dp::io::OutputPolicy::overwrite
+                                                            : dp::io::OutputPolicy::fresh);
       install_stop_handlers();
       result = sim->run(opt, registry);
     } catch (const dp::ConfigError& e) {

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "core/error.hpp"
+#include "io/output_folder.hpp"
 
 namespace domel::platform::io {
 
@@ -39,6 +40,7 @@ fs::path temporary_path_for(const fs::path& path) {
 
 void write_file_atomically(const fs::path& path, const std::string& contents) {
   if (path.empty() || !path.has_filename()) fail(path, "not a file path");
+  record_output(path);
   const fs::path tmp = temporary_path_for(path);
 
   std::FILE* f = std::fopen(tmp.c_str(), "wb");

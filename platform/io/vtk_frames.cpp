@@ -2,6 +2,8 @@
 // ParaView frame series and .pvd collection (see vtk_frames.hpp).
 #include "io/vtk_frames.hpp"
 
+#include "io/output_folder.hpp"
+
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 
@@ -73,6 +75,7 @@ fs::path VtkFrames::write(vtkXMLWriter& writer, double time) {
   std::error_code ec;
   const std::string file = frame_name(frames_.size());
   const fs::path target = directory_ / file;
+  record_output(target);
   fs::path tmp = target;
   tmp += ".tmp-" + std::to_string(static_cast<long long>(::getpid()));
 

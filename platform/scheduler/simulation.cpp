@@ -10,6 +10,7 @@
 #include "io/atomic_file.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
+#include "io/output_folder.hpp"
 #include "io/particle_state.hpp"
 #include "io/vtk_writer.hpp"
 #include "scheduler/checkpoint.hpp"
@@ -105,6 +106,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                                   "checkpoints do not yet cover couplings or the fluid block (docs/checkpoint.md); "
                                   "remove run.checkpoint_interval", ""}});
   std::filesystem::create_directories(out);
+  io::ManifestScope manifest(out);  // lists every file written below (io/output_folder.hpp)
   const int threads_requested =
       options.threads > 0 ? options.threads : (threads > 0 ? threads : default_thread_count());
 

@@ -53,7 +53,7 @@ def run(domel, work, name, path):
         return name, 0
     env = {k: v for k, v in os.environ.items() if k != "DOMEL_PLUGIN_PATH"}
     with open(os.path.join(work, "log_" + name + ".txt"), "w") as log:
-        rc = subprocess.call([domel, "run", path, "--out", out, "--quiet", "--threads", "1"], stdout=log,
+        rc = subprocess.call([domel, "run", path, "--out", out, "--overwrite", "--quiet", "--threads", "1"], stdout=log,
                              stderr=subprocess.STDOUT, env=env)
     return name, rc
 

@@ -18,7 +18,7 @@ runs=(a4_none a4_sd a6_none a6_sd a8_none a8_sd bottom_a4 bottom_a4_unscaled bot
 for r in "${runs[@]}"; do
   [ -f "$out/$r/summary.json" ] && continue
   echo "$r"
-done | xargs -r -P "$jobs" -I{} sh -c '"$0" run "$1" --out "$2/{}" --threads 1 --quiet > "$2/{}.log" 2>&1 && echo "done: {}" || { echo "FAILED: {} (see $2/{}.log)"; exit 1; }' \
+done | xargs -r -P "$jobs" -I{} sh -c '"$0" run "$1" --out "$2/{}" --overwrite --threads 1 --quiet > "$2/{}.log" 2>&1 && echo "done: {}" || { echo "FAILED: {} (see $2/{}.log)"; exit 1; }' \
   "$domel" "$here/chamber_{}.json" "$out"
 args=()
 for r in "${runs[@]}"; do args+=(--runs "$out/$r" --label "$r"); done

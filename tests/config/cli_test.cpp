@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -138,6 +139,65 @@ TEST_F(Cli, RunRefusedAtBuildStageWritesNothing) {
   EXPECT_NE(r.err.find("/subdomains/0/time_step"), std::string::npos) << show(r);
   EXPECT_NE(r.err.find("stability limit"), std::string::npos) << show(r);
   EXPECT_FALSE(fs::exists(out)) << "a refused run created " << out;
+}
+
+// ---- output folders, signals, restarts (docs/checkpoint.md) ---------------------
+
+TEST_F(Cli, ASecondRunIntoAFolderIsRefusedAndOverwriteRemovesOnlyTheFirstRunsFiles) {
+  const fs::path out = tmp_ / "o";
+  ASSERT_EQ(domel({"run", kSettle.string(), "--out", out.string(), "--max-steps", "1100", "--quiet"}).exit_code, 0);
+  ASSERT_TRUE(fs::exists(out / "particles_000001.vtp"));
+  std::ofstream(out / "notes.txt") << "mine\n";
+  const Result again = domel({"run", kSettle.string(), "--out", out.string(), "--max-steps", "5", "--quiet"});
+  EXPECT_EQ(again.exit_code, 2) << show(again);
+  EXPECT_NE(again.err.find(out.string()), std::string::npos) << show(again);
+  EXPECT_NE(again.err.find("--overwrite"), std::string::npos) << show(again);
+  EXPECT_TRUE(fs::exists(out / "particles_000001.vtp")) << "a refused run removed a file";
+  const Result over = domel({"run", kSettle.string(), "--out", out.string(), "--max-steps", "5", "--quiet", "--overwrite"});
+  ASSERT_EQ(over.exit_code, 0) << show(over);
+  EXPECT_FALSE(fs::exists(out / "particles_000001.vtp")) << "the first run's later frame was left behind";
+  EXPECT_TRUE(fs::exists(out / "particles_000000.vtp"));
+  EXPECT_EQ(read_file(out / "notes.txt"), "mine\n") << "--overwrite removed a file domel did not write";
+  const Result both = domel({"run", kSettle.string(), "--out", out.string(), "--overwrite", "--restart",
+                             (out / "checkpoint.ckpt").string()});
+  EXPECT_EQ(both.exit_code, 64) << show(both);
+}
+
+TEST_F(Cli, SigintWritesACheckpointAndTheRestartEndsLikeAnUninterruptedRun) {
+  // the settle example for 0.3 s, stopped by SIGINT part way, then continued
+  const fs::path plain = tmp_ / "plain", cut = tmp_ / "cut";
+  ASSERT_EQ(domel({"run", kSettle.string(), "--out", plain.string(), "--quiet", "--threads", "1"}).exit_code, 0);
+  const std::string cmd = "exec " + shell_quote(kDomel) + " run " + shell_quote(kSettle.string()) + " --out " +
+                          shell_quote(cut.string()) + " --quiet --threads 1 >" + shell_quote((tmp_ / "cut.log").string()) +
+                          " 2>&1";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // wait until it has written a few frames (it takes about 4 s in all)
+  for (int k = 0; k < 200 && !fs::exists(cut / "particles_000003.vtp"); ++k) usleep(20000);
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << read_file(tmp_ / "cut.log");
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the run ended before the signal came";
+  EXPECT_EQ(WEXITSTATUS(status), 130) << read_file(tmp_ / "cut.log");
+  const json s = json::parse(read_file(cut / "summary.json"));
+  EXPECT_EQ(s["status"], "interrupted");
+  EXPECT_EQ(s["signal"], "SIGINT");
+  ASSERT_TRUE(fs::exists(cut / "checkpoint.ckpt"));
+  EXPECT_NE(read_file(tmp_ / "cut.log").find("--restart"), std::string::npos) << "it says how to continue";
+  const Result r = domel({"run", kSettle.string(), "--restart", (cut / "checkpoint.ckpt").string(), "--quiet",
+                          "--threads", "1"});
+  ASSERT_EQ(r.exit_code, 0) << show(r);
+  const json done = json::parse(read_file(cut / "summary.json"));
+  EXPECT_EQ(done["status"], "completed");
+  EXPECT_TRUE(done.contains("restarted_from"));
+  EXPECT_TRUE(read_file(plain / "probes.csv") == read_file(cut / "probes.csv"));
+  EXPECT_TRUE(read_file(plain / "particles.pvd") == read_file(cut / "particles.pvd"));
+  EXPECT_TRUE(read_file(plain / "particles_000030.vtp") == read_file(cut / "particles_000030.vtp"));
 }
 
 TEST_F(Cli, RunWritesCompleteOutputs) {
