@@ -830,7 +830,9 @@ void build_grids(Build& b) {
                      " <= min " + fmt_num(setup.spec.lo[a]));
       }
     if (corners) try {
-        CellGrid probe(setup.spec);  // the grid's own checks
+        CellGridSpec checked = setup.spec;
+        checked.write_interval = std::max(0.0, checked.write_interval);  // -1: the default, filled in later
+        CellGrid probe(checked);  // the grid's own checks
       } catch (const std::invalid_argument& e) {
         b.ck.add(idx("/output/grids", g), e.what());
       }

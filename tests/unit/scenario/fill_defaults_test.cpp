@@ -101,6 +101,18 @@ TEST(FillDefaults, ASchemaDefaultReachesTheBuiltSimulation) {
   EXPECT_EQ(store.vx[0], 0.0);  // insert.velocity default
 }
 
+// A grid without write_interval was refused ("write_interval must be >= 0")
+// although the reference gives its default, duration / 20 (issue 17, item 4):
+// silo_ci's grids without the key validate and get it.
+TEST(FillDefaults, ACellGridWithoutWriteIntervalGetsTheDocumentedDefault) {
+  std::ifstream in(std::string(DOMEL_SOURCE_DIR) + "/scenarios/silo/silo_ci.json");
+  json doc = json::parse(in);
+  for (auto& g : doc["output"]["grids"]) g.erase("write_interval");
+  auto sim = domel::test::build(doc);
+  ASSERT_EQ(sim->grid_setups.size(), 2u);
+  for (const auto& g : sim->grid_setups) EXPECT_DOUBLE_EQ(g.spec.write_interval, sim->duration / 20.0);
+}
+
 TEST(FillDefaults, AFilledWallDefaultOfAnotherWallTypeIsNotAnError) {
   // the wall schema is shared by every type: a plane gets "axis", "scale" and
   // "closed_top" filled, which the plane check must not call misplaced
