@@ -12,6 +12,7 @@
 #include "geometry/region.hpp"
 #include "geometry/triangle_mesh.hpp"  // MeshError
 #include "io/particle_state.hpp"
+#include "subdomain/diagnostics.hpp"
 #include "scenario/scenario.hpp"
 #include "scenario/scenario_detail.hpp"
 
@@ -124,6 +125,71 @@ std::unique_ptr<ContactPipeline> build_contact_pipeline(Build& b, const json& sd
   }
   if (!ok) return nullptr;
   return std::make_unique<ContactPipeline>(std::move(slots));
+}
+
+/// What can be known about a subdomain's starting particles before a step:
+/// overlapping pairs (refused above run.max_initial_overlap, with the ids),
+/// an empty subdomain that nothing fills, and sizes that suggest a scenario
+/// written in millimetres or kilometres (warnings naming the keys).
+void check_initial_particles(Build& b, const Subdomain& sub, const json& sd, const std::string& base) {
+  const ParticleStore& s = const_cast<Subdomain&>(sub).store();
+  const std::string name = sd["name"].get<std::string>();
+  const std::string source = sd.contains("initial_state") ? base + "/initial_state" : base + "/insert";
+  const double limit = b.doc["run"]["max_initial_overlap"].get<double>();
+  const InitialOverlaps o = find_initial_overlaps(s, limit);
+  if (o.pairs > 0)
+    spdlog::info("subdomain '{}': {} overlapping pair(s) at the start, the worst {:.3g} % of the pair's mean diameter "
+                 "(ids {} and {})", name, o.pairs, 100.0 * o.worst, o.worst_ids[0], o.worst_ids[1]);
+  if (o.above_count > 0) {
+    std::string ids;
+    for (const auto& p : o.above)
+      ids += (ids.empty() ? "" : ", ") + std::to_string(p.a) + " and " + std::to_string(p.b) + " (" +
+             fmt_num(100.0 * p.ratio) + " %)";
+    b.ck.add(source,
+             std::to_string(o.above_count) + " particle pair(s) overlap by more than run.max_initial_overlap (" +
+                 fmt_num(100.0 * limit) + " % of the pair's mean diameter): ids " + ids +
+                 (o.above_count > o.above.size() ? ", ..." : "") +
+                 (sd.contains("initial_state") ? " in the state file '" + sd["initial_state"].get<std::string>() + "'"
+                                               : "") +
+                 "; their first contact forces would blow them apart",
+             "separate or remove those particles, or raise /run/max_initial_overlap if the overlaps are intended");
+  }
+  bool fed = sd.contains("pour") && !sd["pour"].empty();
+  fed = fed || b.parent.count(name) != 0;  // the fine level of a coupling is filled by its parent
+  if (s.size() == 0 && !fed)
+    spdlog::warn("subdomain '{}' ({}) is empty and nothing adds particles to it (no insert, initial_state, pour or "
+                 "coupling)", name, base);
+  double dmin = 0, dmax = 0;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    dmin = k == 0 ? 2 * s.radius[k] : std::min(dmin, 2 * s.radius[k]);
+    dmax = std::max(dmax, 2 * s.radius[k]);
+  }
+  if (dmax > 0.5)
+    spdlog::warn("subdomain '{}' ({}): particles of {:.4g} m diameter; domel works in SI units (m, kg, s), so a "
+                 "scenario written in millimetres looks like this", name, source, dmax);
+  if (s.size() > 0 && dmin < 1e-6)
+    spdlog::warn("subdomain '{}' ({}): particles of {:.4g} m diameter (below 1 µm); domel works in SI units, so a "
+                 "scenario written in kilometres looks like this", name, source, dmin);
+  // a container smaller than its particles
+  static const json kNoWalls = json::array();
+  const json& walls = b.doc.contains("walls") ? b.doc["walls"] : kNoWalls;
+  for (std::size_t w = 0; w < walls.size() && dmax > 0; ++w) {
+    const json& wj = walls[w];
+    double extent = std::numeric_limits<double>::infinity();
+    if (wj["type"] == "box")
+      for (int a = 0; a < 3; ++a) extent = std::min(extent, wj["max"][a].get<double>() - wj["min"][a].get<double>());
+    if (wj["type"] == "cylinder") extent = 2 * wj["radius"].get<double>();
+    if (extent < dmax)
+      spdlog::warn("subdomain '{}': particles of {:.4g} m diameter ({}) are larger than the wall at {} ({:.4g} m "
+                   "across); check the units of both (domel works in m)", name, dmax, source, idx("/walls", w),
+                   extent);
+  }
+  const double dt = sd["time_step"].is_number() ? sd["time_step"].get<double>() : 0.0;
+  const json& mat = b.doc["materials"][sd["material"].get<std::string>()];
+  if (dt > 1e-3 && mat["youngs_modulus"].get<double>() > 1e8)
+    spdlog::warn("subdomain '{}': time step {:.3g} s ({}/time_step) with a Young's modulus of {:.3g} Pa "
+                 "(/materials/{}/youngs_modulus): stiff particles need steps of microseconds; is the time in ms?",
+                 name, dt, base, mat["youngs_modulus"].get<double>(), sd["material"].get<std::string>());
 }
 
 /// A subdomain's particles from its initial_state file.
@@ -339,6 +405,7 @@ void build_subdomain(Build& b, std::size_t k) {
   std::vector<double> pour_radii;
   build_pours(b, *sub, sd, base, density, pour_radii);
   if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
+  check_initial_particles(b, *sub, sd, base);
   // The fine level of a coupling starts empty: its particles will be its
   // parent's parcels at its own ratio, which set its skin and time step.
   bool coarse_listed = false;  // a self-coupling or an unknown name is build_couplings()'s to report

@@ -3,7 +3,9 @@
 #include "subdomain/diagnostics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <unordered_map>
 
 namespace domel::platform {
 
@@ -70,6 +72,66 @@ void count_contacts(ParticleStore& s, const NeighborList& list, std::size_t scre
     for (std::size_t e = 0; e < wl.particle.size(); ++e)
       if (wl.touching[e] && wl.particle[e] < s.size()) ++s.contacts[wl.particle[e]];
   }
+}
+
+InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit) {
+  InitialOverlaps out;
+  const std::size_t n = s.size();
+  if (n < 2) return out;
+  double rmax = 0, lo[3] = {s.x[0], s.y[0], s.z[0]};
+  for (std::size_t k = 0; k < n; ++k) {
+    rmax = std::max(rmax, s.radius[k]);
+    lo[0] = std::min(lo[0], s.x[k]);
+    lo[1] = std::min(lo[1], s.y[k]);
+    lo[2] = std::min(lo[2], s.z[k]);
+  }
+  if (!(rmax > 0) || !std::isfinite(lo[0] + lo[1] + lo[2])) return out;
+  // hash the cells (x, y, z) -> particles: a sparse pour or a tall silo needs no dense grid
+  const double cell = 2.0 * rmax;
+  using Cell = std::array<long long, 3>;
+  struct CellHash {
+    std::size_t operator()(const Cell& c) const {
+      return static_cast<std::size_t>((static_cast<std::uint64_t>(c[0]) * 73856093ull) ^
+                                      (static_cast<std::uint64_t>(c[1]) * 19349663ull) ^
+                                      (static_cast<std::uint64_t>(c[2]) * 83492791ull));
+    }
+  };
+  auto key = [](long long i, long long j, long long k) { return Cell{i, j, k}; };
+  auto coord = [&](double v, int a) { return static_cast<long long>(std::floor((v - lo[a]) / cell)); };
+  std::unordered_map<Cell, std::vector<std::uint32_t>, CellHash> cells;
+  cells.reserve(n);
+  for (std::size_t k = 0; k < n; ++k)
+    cells[key(coord(s.x[k], 0), coord(s.y[k], 1), coord(s.z[k], 2))].push_back(static_cast<std::uint32_t>(k));
+  std::vector<InitialOverlaps::Pair> above;
+  for (std::size_t p = 0; p < n; ++p) {
+    const long long ci = coord(s.x[p], 0), cj = coord(s.y[p], 1), ck = coord(s.z[p], 2);
+    for (long long di = -1; di <= 1; ++di)
+      for (long long dj = -1; dj <= 1; ++dj)
+        for (long long dk = -1; dk <= 1; ++dk) {
+          const auto it = cells.find(key(ci + di, cj + dj, ck + dk));
+          if (it == cells.end()) continue;
+          for (std::uint32_t q : it->second) {
+            if (q <= p) continue;  // each pair once: q sits in one cell, visited once from p
+            const double dx = s.x[p] - s.x[q], dy = s.y[p] - s.y[q], dz = s.z[p] - s.z[q];
+            const double rsum = s.radius[p] + s.radius[q];
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            if (d2 >= rsum * rsum) continue;
+            const double ratio = (rsum - std::sqrt(d2)) / rsum;
+            ++out.pairs;
+            if (ratio > out.worst) {
+              out.worst = ratio;
+              out.worst_ids[0] = s.id[p];
+              out.worst_ids[1] = s.id[q];
+            }
+            if (ratio > limit) above.push_back({s.id[p], s.id[q], ratio});
+          }
+        }
+  }
+  out.above_count = above.size();
+  std::sort(above.begin(), above.end(), [](const auto& a, const auto& b) { return a.ratio > b.ratio; });
+  if (above.size() > 5) above.resize(5);
+  out.above = std::move(above);
+  return out;
 }
 
 }  // namespace domel::platform

@@ -43,6 +43,22 @@ struct MemoryUse {
   std::size_t threads = 0;          ///< the other threads' force arrays
 };
 
+/// Overlapping pairs among a set of particles before any step (from a state
+/// file or insertions), by a cell list of side 2 r_max: O(N).
+struct InitialOverlaps {
+  std::size_t pairs = 0;      ///< pairs with delta > 0
+  double worst = 0;           ///< largest delta / (R_i + R_j), the probes' max_overlap_ratio
+  std::uint64_t worst_ids[2] = {0, 0};
+  /// The pairs above `limit` (worst first, at most 5): ids and ratio.
+  struct Pair {
+    std::uint64_t a, b;
+    double ratio;
+  };
+  std::vector<Pair> above;
+  std::size_t above_count = 0;  ///< how many pairs exceed `limit` in all
+};
+InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit);
+
 /// The kinetic part of the statistics (particles, fixed, energies, angular speeds).
 SubdomainStats kinetic_stats(const ParticleStore& s);
 

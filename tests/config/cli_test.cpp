@@ -141,6 +141,61 @@ TEST_F(Cli, RunRefusedAtBuildStageWritesNothing) {
   EXPECT_FALSE(fs::exists(out)) << "a refused run created " << out;
 }
 
+// ---- sanity checks before a run (issue 17, item 4) ----------------------------
+
+/// The settle example with its particles from a state file of `rows`
+/// ("id,x,y,z,radius" per row, the rest zero), written into `dir`.
+fs::path settle_from_state(const fs::path& dir, const std::vector<std::string>& rows) {
+  std::ofstream state(dir / "state.csv");
+  state << "id,x,y,z,radius,vx,vy,vz,wx,wy,wz,fixed\n";
+  for (const auto& r : rows) state << r << ",0,0,0,0,0,0,0\n";
+  json doc = json::parse(read_file(kSettle));
+  doc["subdomains"][0].erase("insert");
+  doc["subdomains"][0]["initial_state"] = "state.csv";
+  const fs::path f = dir / "from_state.json";
+  std::ofstream(f) << doc.dump(1);
+  return f;
+}
+
+TEST_F(Cli, AStateFileWithLargeOverlapsIsRefusedAtValidateNamingTheParticles) {
+  // two pairs overlapping by 73 % and 10 % of their mean diameter, one by 1 %
+  const fs::path f = settle_from_state(tmp_, {"1,0.01,0.01,0.01,0.0014", "2,0.01,0.01,0.010756,0.0014",
+                                              "3,0.02,0.02,0.01,0.0014", "4,0.02,0.02,0.01252,0.0014",
+                                              "5,0.01,0.02,0.01,0.0014", "6,0.01,0.02,0.012772,0.0014"});
+  const Result r = domel({"validate", f.string()});
+  EXPECT_EQ(r.exit_code, 2) << show(r);
+  EXPECT_NE(r.err.find("/subdomains/0/initial_state"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("2 particle pair(s) overlap"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("ids 1 and 2 (73 %), 3 and 4 (10 %)"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("state.csv"), std::string::npos) << show(r);
+  const Result run = domel({"run", f.string(), "--out", (tmp_ / "o").string(), "--quiet"});
+  EXPECT_EQ(run.exit_code, 2) << show(run);
+  EXPECT_FALSE(fs::exists(tmp_ / "o"));
+  // a pair within the limit: reported, accepted
+  const fs::path ok = settle_from_state(tmp_, {"5,0.01,0.02,0.01,0.0014", "6,0.01,0.02,0.012772,0.0014"});
+  const Result fine = domel({"validate", ok.string()});
+  EXPECT_EQ(fine.exit_code, 0) << show(fine);
+  EXPECT_NE(fine.err.find("1 overlapping pair(s) at the start, the worst 1 %"), std::string::npos) << show(fine);
+}
+
+TEST_F(Cli, AScenarioInMillimetresAndAnEmptySubdomainAreWarnedAbout) {
+  json doc = json::parse(read_file(kSettle));
+  auto& ins = doc["subdomains"][0]["insert"][0];
+  ins["diameter"] = 2.8;  // millimetres
+  ins["region"]["box"]["max"] = {28.56, 28.56, 57.12};
+  doc["walls"][0]["max"] = {28.56, 28.56, 120};
+  doc["subdomains"][0]["time_step"] = "auto";
+  doc["subdomains"].push_back({{"name", "empty"}, {"material", "beads"}, {"time_step", 1e-5}});
+  const fs::path f = tmp_ / "mm.json";
+  std::ofstream(f) << doc.dump(1);
+  const Result r = domel({"validate", f.string()});
+  EXPECT_NE(r.err.find("particles of 2.8 m diameter; domel works in SI units (m, kg, s), so a scenario written in "
+                       "millimetres looks like this"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("/subdomains/0/insert"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("subdomain 'empty' (/subdomains/1) is empty and nothing adds particles to it"),
+            std::string::npos) << show(r);
+}
+
 // ---- output folders, signals, restarts (docs/checkpoint.md) ---------------------
 
 TEST_F(Cli, ASecondRunIntoAFolderIsRefusedAndOverwriteRemovesOnlyTheFirstRunsFiles) {
