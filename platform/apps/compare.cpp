@@ -3,9 +3,10 @@
 #include "apps/compare.hpp"
 
 #include "core/error.hpp"
-#include "io/output_folder.hpp"
 #include "io/atomic_file.hpp"
+#include "io/output_folder.hpp"
 #include "scenario/scenario.hpp"
+#include "scheduler/schedule.hpp"
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
@@ -117,7 +118,8 @@ std::filesystem::path write_report(const std::filesystem::path& out, const std::
   md << "\n";
   if (!finals.empty())
     for (std::size_t c = 0; c < finals[0].size(); ++c) {
-      md << "| " << finals[0][c].first << " |";
+      const std::string unit = probe_column_unit(finals[0][c].first);
+      md << "| " << finals[0][c].first << (unit.empty() || unit == "1" ? "" : " [" + unit + "]") << " |";
       for (const auto& f : finals) md << " " << (c < f.size() ? fmt(f[c].second) : "–") << " |";
       md << "\n";
     }
@@ -205,6 +207,18 @@ std::filesystem::path run_compare(const CompareOptions& options, PluginRegistry&
   }
 
   const std::filesystem::path out = options.output_directory;
+  std::string capped;  // the variants --max-steps stops before their end, for the log and the report
+  if (options.max_steps > 0)
+    for (std::size_t k = 0; k < sims.size(); ++k) {
+      const double macro = sims[k]->macro_step();
+      const auto total = static_cast<std::uint64_t>(std::ceil(sims[k]->duration / macro - kTimeTolerance));
+      if (options.max_steps >= total) continue;
+      spdlog::warn("compare: variant '{}' stops after {} of its {} macro steps (--max-steps), at t = {:.6g} s of "
+                   "{:.6g} s: its final values are not the scenario's end", options.variants[k].label,
+                   options.max_steps, total, options.max_steps * macro, sims[k]->duration);
+      capped += (capped.empty() ? "" : "; ") + options.variants[k].label + ": " + std::to_string(options.max_steps) +
+                " of " + std::to_string(total) + " macro steps";
+    }
   // a comparison run again replaces its variants' earlier runs (their
   // manifests say which files; io/output_folder.hpp), checked before any runs
   for (const auto& v : options.variants) io::prepare_output_folder(out / slug(v.label), io::OutputPolicy::overwrite);
@@ -232,7 +246,8 @@ std::filesystem::path run_compare(const CompareOptions& options, PluginRegistry&
   }
   const std::string intro = "Scenario `" + options.scenario.string() + "`, " + std::to_string(sims.size()) +
                             " variants, identical seeds and insertion; written by `domel compare` (domel " +
-                            DOMEL_VERSION + ").";
+                            DOMEL_VERSION + ")." +
+                            (capped.empty() ? "" : " **Stopped early by --max-steps** (" + capped + ").");
   return write_report(out, "A/B comparison: " + options.scenario.filename().string(), intro, "overrides", labels, rows,
                       dirs, summaries);
 }

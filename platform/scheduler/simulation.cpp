@@ -36,18 +36,19 @@ namespace {
 /// order: one table gives both the header and the values of a row.
 struct ProbeColumn {
   const char* name;
+  const char* unit;  ///< SI, "1" for counts and ratios
   double (*value)(const SubdomainStats&);
 };
 const ProbeColumn kProbeColumns[] = {
-    {"particles", [](const SubdomainStats& s) { return static_cast<double>(s.particles); }},
-    {"ke_translational", [](const SubdomainStats& s) { return s.kinetic_translational; }},
-    {"ke_rotational", [](const SubdomainStats& s) { return s.kinetic_rotational; }},
-    {"mean_angular_speed", [](const SubdomainStats& s) { return s.mean_angular_speed; }},
-    {"median_angular_speed", [](const SubdomainStats& s) { return s.median_angular_speed; }},
-    {"trimmed_mean_angular_speed", [](const SubdomainStats& s) { return s.trimmed_mean_angular_speed; }},
-    {"max_overlap_ratio", [](const SubdomainStats& s) { return s.max_overlap_ratio; }},
-    {"contacts", [](const SubdomainStats& s) { return static_cast<double>(s.contacts); }},
-    {"wall_contacts", [](const SubdomainStats& s) { return static_cast<double>(s.wall_contacts); }},
+    {"particles", "1", [](const SubdomainStats& s) { return static_cast<double>(s.particles); }},
+    {"ke_translational", "J", [](const SubdomainStats& s) { return s.kinetic_translational; }},
+    {"ke_rotational", "J", [](const SubdomainStats& s) { return s.kinetic_rotational; }},
+    {"mean_angular_speed", "rad/s", [](const SubdomainStats& s) { return s.mean_angular_speed; }},
+    {"median_angular_speed", "rad/s", [](const SubdomainStats& s) { return s.median_angular_speed; }},
+    {"trimmed_mean_angular_speed", "rad/s", [](const SubdomainStats& s) { return s.trimmed_mean_angular_speed; }},
+    {"max_overlap_ratio", "1", [](const SubdomainStats& s) { return s.max_overlap_ratio; }},
+    {"contacts", "1", [](const SubdomainStats& s) { return static_cast<double>(s.contacts); }},
+    {"wall_contacts", "1", [](const SubdomainStats& s) { return static_cast<double>(s.wall_contacts); }},
 };
 
 std::string format_seconds(double s) {
@@ -85,6 +86,19 @@ std::pair<double, std::size_t> mass_in_region(const std::vector<std::unique_ptr<
 }
 
 }  // namespace
+
+std::string probe_column_unit(const std::string& column) {
+  if (column == "time") return "s";
+  const auto dot = column.rfind('.');
+  const std::string name = dot == std::string::npos ? column : column.substr(dot + 1);
+  for (const auto& c : kProbeColumns)
+    if (name == c.name) return c.unit;
+  // the region-mass, repose, deletion and plane columns (Simulation::run, ParticleFlow::columns)
+  if (name == "repose_angle_deg") return "deg";
+  if (name == "mass_kg" || name == "removed_kg") return "kg";
+  if (name == "rate_kg_s") return "kg/s";
+  return "";
+}
 
 RunResult Simulation::run(const RunOptions& options, const PluginRegistry& registry) {
   RunResult result;

@@ -55,6 +55,10 @@ struct RegionMassProbe {
   std::optional<double> max_speed;  ///< [m/s] only particles slower than this
 };
 
+/// The unit of a probes.csv column ("s", "J", "rad/s", "kg", "1" for counts
+/// and ratios ...), "" for a column it does not know.
+std::string probe_column_unit(const std::string& column);
+
 class Simulation {
  public:
   Simulation() = default;

@@ -427,7 +427,13 @@ TEST_F(Cli, CompareRunsVariantsAndWritesAReport) {
   ASSERT_EQ(r.exit_code, 0) << show(r);
   const std::string report = read_file(out / "report.md");
   EXPECT_NE(report.find("| quantity | sd | dct |"), std::string::npos) << report;
-  EXPECT_NE(report.find("column.median_angular_speed"), std::string::npos) << report;
+  EXPECT_NE(report.find("column.median_angular_speed [rad/s]"), std::string::npos) << report;
+  EXPECT_NE(report.find("column.ke_translational [J]"), std::string::npos) << report;
+  EXPECT_NE(report.find("| time [s] |"), std::string::npos) << report;
+  EXPECT_NE(report.find("Stopped early by --max-steps** (sd: 40 of 30000 macro steps; dct: 40 of 30000"),
+            std::string::npos) << report;
+  EXPECT_NE(r.err.find("variant 'sd' stops after 40 of its 30000 macro steps (--max-steps)"), std::string::npos)
+      << show(r);
   for (const char* v : {"sd", "dct"}) {
     EXPECT_TRUE(fs::is_regular_file(out / v / "summary.json")) << v;
     const json s = json::parse(read_file(out / v / "summary.json"));
