@@ -20,6 +20,15 @@ double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b
 
 std::string quoted(const std::filesystem::path& f) { return "'" + f.string() + "'"; }
 
+/// A word of the file as a message may show it: at most 40 characters, bytes
+/// outside printable ASCII as '?' (a binary file's bytes would garble the terminal).
+std::string printable(const std::string& w) {
+  std::string p = w.size() > 40 ? w.substr(0, 37) + "..." : w;
+  for (char& c : p)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+  return p;
+}
+
 std::vector<double> read_ascii_stl(const std::filesystem::path& file, const std::string& text) {
   std::vector<double> out;
   std::istringstream in(text);
@@ -27,7 +36,7 @@ std::vector<double> read_ascii_stl(const std::filesystem::path& file, const std:
   int line_no = 0;
   int corners = 0;   // vertices seen in the current facet
   bool in_facet = false;
-  bool saw_solid = false;
+  bool saw_solid = false, saw_endsolid = false;
   auto fail = [&](const std::string& what) {
     throw MeshError("STL file " + quoted(file) + ", line " + std::to_string(line_no) + ": " + what);
   };
@@ -51,8 +60,8 @@ std::vector<double> read_ascii_stl(const std::filesystem::path& file, const std:
         if (!(ls >> tok)) fail("expected 3 coordinates after 'vertex'");
         char* end = nullptr;
         c = std::strtod(tok.c_str(), &end);
-        if (end == tok.c_str() || *end != '\0') fail("expected a number, found '" + tok + "'");
-        if (!std::isfinite(c)) fail("non-finite coordinate '" + tok + "'");
+        if (end == tok.c_str() || *end != '\0') fail("expected a number, found '" + printable(tok) + "'");
+        if (!std::isfinite(c)) fail("non-finite coordinate '" + printable(tok) + "'");
       }
       if (++corners > 3) fail("more than 3 vertices in a facet (triangle " + std::to_string(out.size() / 9 + 1) + ")");
       out.insert(out.end(), v, v + 3);
@@ -64,12 +73,14 @@ std::vector<double> read_ascii_stl(const std::filesystem::path& file, const std:
       in_facet = false;
     } else if (word == "endsolid") {
       if (in_facet) fail("'endsolid' inside a facet");
+      saw_endsolid = true;
     } else {
-      fail("unexpected '" + word + "' (expected solid, facet, outer loop, vertex, endloop, endfacet or endsolid)");
+      fail("unexpected '" + printable(word) + "' (expected solid, facet, outer loop, vertex, endloop, endfacet or endsolid)");
     }
   }
   if (in_facet) fail("file ends inside a facet");
   if (!saw_solid) throw MeshError("STL file " + quoted(file) + ": not an STL file (neither 'solid ...' text nor a binary STL of 84 + 50 n bytes)");
+  if (!saw_endsolid) fail("the file ends without 'endsolid': it is truncated");
   return out;
 }
 

@@ -28,6 +28,8 @@ std::string trim(const std::string& s) {
 [[noreturn]] void fail(const std::filesystem::path& file, std::size_t line, const std::string& what,
                        const std::string& found) {
   std::string f = found.size() > 80 ? found.substr(0, 77) + "..." : found;
+  for (char& c : f)  // a binary file's bytes would garble the terminal
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
   throw std::runtime_error(file.string() + ":" + std::to_string(line) + ": " + what + ", found '" + f + "'");
 }
 

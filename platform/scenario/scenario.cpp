@@ -495,6 +495,39 @@ std::vector<Diagnostic> validate_document(json& doc, const std::filesystem::path
   return ck.diags;
 }
 
+/// Deepest nesting of arrays and objects a scenario may have. The deepest
+/// shipped scenario nests 7 levels; the validator and the builders recurse
+/// once per level, so a document nested hundreds of thousands deep would
+/// overflow the stack.
+constexpr std::size_t kMaxJsonDepth = 64;
+
+/// Where the text first nests deeper than kMaxJsonDepth (outside strings),
+/// as "line L, column C"; empty when it never does.
+std::string too_deep_at(const std::string& text) {
+  std::size_t depth = 0, line = 1, column = 0;
+  bool in_string = false, escaped = false;
+  for (char c : text) {
+    ++column;
+    if (c == '\n') {
+      ++line;
+      column = 0;
+    }
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') in_string = true;
+    else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) return "line " + std::to_string(line) + ", column " + std::to_string(column);
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return {};
+}
+
 json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& diags) {
   std::ifstream in(file, std::ios::binary);
   if (!in) {
@@ -503,16 +536,31 @@ json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& 
   }
   std::stringstream ss;
   ss << in.rdbuf();
-  try {
-    return json::parse(ss.str());
-  } catch (const json::parse_error& e) {
-    std::string what = e.what();
-    const auto pos = what.find("] ");
-    if (pos != std::string::npos) what = what.substr(pos + 2);
-    diags.push_back({file.string(), "", "not valid JSON: " + what,
-                     "look for a missing ',' or '\"' just before that position, or a trailing ','"});
+  const std::string text = ss.str();
+  if (const std::string at = too_deep_at(text); !at.empty()) {
+    diags.push_back({file.string(), "", "arrays and objects nest deeper than " + std::to_string(kMaxJsonDepth) +
+                                            " levels at " + at + "; a scenario nests a few levels",
+                     "look for a bracket that is never closed"});
     return {};
   }
+  auto message = [](const json::exception& e) {
+    std::string what = e.what();
+    const auto pos = what.find("] ");
+    return pos == std::string::npos ? what : what.substr(pos + 2);
+  };
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    diags.push_back({file.string(), "", "not valid JSON: " + message(e),
+                     "look for a missing ',' or '\"' just before that position, or a trailing ','"});
+  } catch (const json::out_of_range& e) {
+    // a number beyond the range of a double, e.g. 1e400
+    diags.push_back({file.string(), "", "not a usable number: " + message(e) + " (beyond +-1.8e308, the range of a "
+                                        "double)", "write the number in SI units within the range of a double"});
+  } catch (const json::exception& e) {
+    diags.push_back({file.string(), "", "not valid JSON: " + message(e), ""});
+  }
+  return {};
 }
 
 }  // namespace

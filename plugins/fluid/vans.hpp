@@ -59,7 +59,7 @@ class Vans {
       "properties": {
         "min": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m", "description": "lower corner" },
         "max": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m", "description": "upper corner" },
-        "cells": { "type": "array", "items": { "type": "integer", "minimum": 1 }, "minItems": 3, "maxItems": 3, "description": "cells along x, y, z" } },
+        "cells": { "type": "array", "items": { "type": "integer", "minimum": 1, "maximum": 4096 }, "minItems": 3, "maxItems": 3, "description": "cells along x, y, z" } },
       "required": ["min", "max", "cells"], "additionalProperties": false },
     "density": { "type": "number", "exclusiveMinimum": 0, "x-unit": "kg/m^3", "description": "fluid density rho_f (air: 1.2)" },
     "viscosity": { "type": "number", "exclusiveMinimum": 0, "x-unit": "Pa s", "description": "dynamic viscosity mu (air: 1.8e-5)" },
@@ -78,14 +78,14 @@ class Vans {
     "pressure_gradient_force": { "type": "boolean", "default": true, "description": "apply -V grad p to each particle (model A; it holds buoyancy)" },
     "coupling": { "enum": ["two_way", "one_way"], "default": "two_way", "description": "one_way: the fluid ignores the particles (eps = 1, no drag on the fluid)" },
     "void_fraction_min": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.3, "x-unit": "1", "description": "eps is clamped to at least this in the fluid equations and the drag laws" },
-    "substeps": { "oneOf": [ { "type": "integer", "minimum": 1 }, { "const": "auto" } ], "default": 1, "description": "fluid steps per coupling interval, or \"auto\": at every exchange the fewest steps (up to max_substeps) that keep the fluid step within its advective (cfl) and viscous limits for the flow as it stands" },
-    "max_substeps": { "type": "integer", "minimum": 1, "default": 16, "description": "with substeps \"auto\": the most fluid steps per coupling interval; the interval is refused (with the limit named) when even these are not enough" },
+    "substeps": { "oneOf": [ { "type": "integer", "minimum": 1, "maximum": 1000000 }, { "const": "auto" } ], "default": 1, "description": "fluid steps per coupling interval, or \"auto\": at every exchange the fewest steps (up to max_substeps) that keep the fluid step within its advective (cfl) and viscous limits for the flow as it stands" },
+    "max_substeps": { "type": "integer", "minimum": 1, "maximum": 1000000, "default": 16, "description": "with substeps \"auto\": the most fluid steps per coupling interval; the interval is refused (with the limit named) when even these are not enough" },
     "cfl": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5, "x-unit": "1", "description": "advective Courant number limit of a fluid step, sum_a |u_a| dt / dx_a (first-order upwind)" },
     "initial_velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "fluid velocity at the start" },
     "solver": { "type": "object", "default": {}, "properties": {
         "backend": { "enum": ["auto", "cg", "pfmg"], "default": "auto", "description": "pressure solve: cg = Eigen's conjugate gradient with incomplete Cholesky (cost per cell grows with the grid); pfmg = hypre's structured multigrid (PFMG-preconditioned CG; cost per cell about constant; needs a domel built with Debian's libhypre-dev); auto = pfmg when available, else cg" },
         "tolerance": { "type": "number", "exclusiveMinimum": 0, "default": 1e-8, "x-unit": "1", "description": "relative residual of the pressure solve" },
-        "max_iterations": { "type": "integer", "minimum": 1, "default": 2000, "description": "iterations of the pressure solve" } },
+        "max_iterations": { "type": "integer", "minimum": 1, "maximum": 100000000, "default": 2000, "description": "iterations of the pressure solve" } },
       "additionalProperties": false }
   },
   "required": ["grid", "density", "viscosity"],

@@ -50,7 +50,7 @@ class Lattice {
                  "description": "lattice constant as a multiple of the diameter; 1 puts neighbours in contact" },
     "jitter": { "type": "number", "minimum": 0, "default": 0, "x-unit": "1",
                 "description": "each coordinate is displaced uniformly in [-jitter*d, +jitter*d]; at most (spacing-1)/2 so that particles cannot overlap" },
-    "count": { "type": "integer", "minimum": 1,
+    "count": { "type": "integer", "minimum": 1, "maximum": 100000000,
                "description": "stop after this many particles (default: fill every site)" },
     "arrangement": { "enum": ["simple_cubic"], "default": "simple_cubic",
                      "description": "lattice type" },

@@ -56,7 +56,7 @@ class RandomFill {
                "description": "number of particles to insert" },
     "volume_fraction": { "type": "number", "exclusiveMinimum": 0, "maximum": 0.38, "x-unit": "1",
                          "description": "target solid volume fraction of the region; the count is region volume * fraction / mean sphere volume. At most 0.38, about the jamming limit of random sequential addition in 3-D; walls make bounded regions jam lower and filling beyond about 0.3 gets slow and may fail, so use the lattice model for dense packings" },
-    "max_attempts": { "type": "integer", "minimum": 1, "default": 1000,
+    "max_attempts": { "type": "integer", "minimum": 1, "maximum": 1000000000, "default": 1000,
                       "description": "candidate positions drawn for one particle before the insertion fails" }
   },
   "required": ["diameter"],

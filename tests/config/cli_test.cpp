@@ -196,6 +196,103 @@ TEST_F(Cli, AScenarioInMillimetresAndAnEmptySubdomainAreWarnedAbout) {
             std::string::npos) << show(r);
 }
 
+// ---- hostile files (issue 17, item 6; docs/reliability.md) ----------------------
+
+// Shapes a fuzzer's short inputs miss, generated here: each is refused with
+// exit 2 and a message naming the file, never a crash or a raw library
+// exception.
+TEST_F(Cli, HostileFilesAreRefusedNamingTheFile) {
+  const json settle = json::parse(read_file(kSettle));
+  struct Case {
+    std::string name, expect;
+  };
+  std::vector<Case> cases;
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(tmp_ / name, std::ios::binary) << text;
+  };
+  auto scenario = [&](const std::string& name, const json& doc, const std::string& expect) {
+    write(name, doc.dump());
+    cases.push_back({name, expect});
+  };
+  // nesting hundreds of thousands deep, as arrays and as an unknown member
+  write("deep.json", std::string(300000, '[') + std::string(300000, ']'));
+  cases.push_back({"deep.json", "nest deeper than 64 levels"});
+  {
+    std::string d = settle.dump();
+    d.pop_back();
+    d += ",\"extra\":" + std::string(200000, '[') + std::string(200000, ']') + "}";
+    write("deep_member.json", d);
+    cases.push_back({"deep_member.json", "nest deeper than 64 levels"});
+  }
+  // tens of megabytes of garbage, and of a valid file's text cut in half
+  {
+    std::string g(30u << 20, 'x');
+    for (std::size_t k = 0; k < g.size(); k += 7) g[k] = static_cast<char>(k * 131 % 256);
+    write("garbage.json", g);
+    cases.push_back({"garbage.json", "not valid JSON"});
+    json big = settle;
+    big["description"] = std::string(30u << 20, 'd');
+    const std::string text = big.dump();
+    write("cut.json", text.substr(0, text.size() / 2));
+    cases.push_back({"cut.json", "not valid JSON"});
+  }
+  // numbers beyond a double, and beyond 64 bits where an integer is read
+  write("overflow.json", std::regex_replace(settle.dump(), std::regex("\"duration\":0\\.3"), "\"duration\":1e400"));
+  cases.push_back({"overflow.json", "beyond +-1.8e308"});
+  {
+    json d = settle;
+    d["run"]["seed"] = 1e26;
+    scenario("seed.json", d, "/run/seed: expected an integer <= 18446744073709551615");
+  }
+  // a long string where a name goes
+  {
+    json d = settle;
+    d["subdomains"][0]["material"] = std::string(5u << 20, 'm');
+    scenario("long.json", d, "/subdomains/0/material");
+  }
+  // every file a scenario can name, truncated or garbage
+  {
+    std::string junk(5000, '\0');
+    for (std::size_t k = 0; k < junk.size(); ++k) junk[k] = static_cast<char>((k * 7919 + 13) % 256);
+    const std::string stl = read_file(fs::path(DOMEL_SOURCE_DIR) / "scenarios/examples/chute.stl");
+    json hopper = json::parse(read_file(fs::path(DOMEL_SOURCE_DIR) / "scenarios/examples/hopper.json"));
+    std::size_t mesh = 0;
+    while (hopper["walls"][mesh]["type"] != "mesh") ++mesh;
+    for (const auto& [file, text] : std::vector<std::pair<std::string, std::string>>{
+             {"cut.stl", stl.substr(0, stl.size() / 2)}, {"junk.stl", junk}, {"solid_junk.stl", "solid x\n" + junk}}) {
+      write(file, text);
+      hopper["walls"][mesh]["file"] = file;
+      scenario("mesh_" + file + ".json", hopper, file);
+    }
+    const std::string header = "id,x,y,z,radius,vx,vy,vz,wx,wy,wz,fixed\n";
+    for (const auto& [file, text] : std::vector<std::pair<std::string, std::string>>{
+             {"cut.csv", header + "1,0.01,0.01,0.01,0.0014,0,0,0,0,0,0,0\n2,0.02,0.0"}, {"junk.csv", junk},
+             {"nan.csv", header + "1,nan,0.01,0.01,0.0014,0,0,0,0,0,0,0\n"}, {"big.csv", header + "1,1e400,0,0,1,0,0,0,0,0,0,0\n"}}) {
+      write(file, text);
+      json d = settle;
+      d["subdomains"][0].erase("insert");
+      d["subdomains"][0]["initial_state"] = file;
+      scenario("state_" + file + ".json", d, file);
+    }
+    write("junk.so", junk);
+    write("empty.so", "");
+    for (const char* lib : {"junk.so", "empty.so"}) {
+      json d = settle;
+      d["plugins"] = {lib};
+      scenario(std::string("plugin_") + lib + ".json", d, lib);
+    }
+  }
+  for (const auto& c : cases) {
+    const Result r = domel({"validate", (tmp_ / c.name).string()});
+    EXPECT_EQ(r.exit_code, 2) << c.name << ": " << show(r).substr(0, 2000);
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.name << ": " << show(r).substr(0, 2000);
+    EXPECT_EQ(r.err.find("json.exception"), std::string::npos) << c.name << ": a raw library exception";
+    const Result run = domel({"run", (tmp_ / c.name).string(), "--out", (tmp_ / "never").string(), "--quiet"});
+    EXPECT_EQ(run.exit_code, 2) << c.name << ": " << show(run).substr(0, 2000);
+    EXPECT_FALSE(fs::exists(tmp_ / "never")) << c.name;
+  }
+}
+
 // ---- output folders, signals, restarts (docs/checkpoint.md) ---------------------
 
 TEST_F(Cli, ASecondRunIntoAFolderIsRefusedAndOverwriteRemovesOnlyTheFirstRunsFiles) {

@@ -6,6 +6,7 @@
 // it; and the builders read no key with a second, in-code fallback.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -15,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/error.hpp"
 #include "scenario/json_schema.hpp"
 #include "scenario/scenario.hpp"
 #include "support/fixture.hpp"
@@ -111,6 +113,39 @@ TEST(FillDefaults, ACellGridWithoutWriteIntervalGetsTheDocumentedDefault) {
   auto sim = domel::test::build(doc);
   ASSERT_EQ(sim->grid_setups.size(), 2u);
   for (const auto& g : sim->grid_setups) EXPECT_DOUBLE_EQ(g.spec.write_interval, sim->duration / 20.0);
+}
+
+// Every integer key of the composed schema (platform and built-in plugins)
+// has a maximum: the builders and plugins read them into 32- or 64-bit
+// integers, and a JSON number such as 1e26 is an integer by JSON Schema's
+// rules, so without a maximum it would reach a conversion it overflows
+// (docs/reliability.md).
+TEST(FillDefaults, EveryIntegerKeyOfTheSchemaHasAMaximum) {
+  const json schema = domel::platform::composed_scenario_schema(domel::test::builtin_registry());
+  std::vector<std::string> missing;
+  std::vector<std::pair<const json*, std::string>> todo = {{&schema, ""}};
+  while (!todo.empty()) {
+    const auto [node, path] = todo.back();
+    todo.pop_back();
+    if (node->is_object()) {
+      const auto t = node->find("type");
+      const bool integer = t != node->end() && (*t == "integer" || (t->is_array() && std::find(t->begin(), t->end(),
+                                                                                               "integer") != t->end()));
+      if (integer && !node->contains("maximum") && !node->contains("enum")) missing.push_back(path);
+      for (const auto& [k, v] : node->items()) todo.push_back({&v, path + "/" + k});
+    } else if (node->is_array()) {
+      for (std::size_t k = 0; k < node->size(); ++k) todo.push_back({&(*node)[k], path + "/" + std::to_string(k)});
+    }
+  }
+  EXPECT_TRUE(missing.empty()) << "integer keys without a maximum: " << ::testing::PrintToString(missing);
+}
+
+// 1e26 is an integer to JSON Schema; the seed's maximum refuses it instead
+// of converting it to a 64-bit seed (undefined behaviour).
+TEST(FillDefaults, AnIntegerBeyond64BitsIsRefusedNotConverted) {
+  json doc = minimal_scenario();
+  doc["run"]["seed"] = 1e26;
+  EXPECT_THROW(domel::test::build(doc), domel::platform::ConfigError);
 }
 
 TEST(FillDefaults, AFilledWallDefaultOfAnotherWallTypeIsNotAnError) {
