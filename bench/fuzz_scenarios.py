@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""Fuzz the scenario reader and validator (docs/reliability.md).
+
+Builds tests/fuzz/scenario_fuzz.cpp with clang, libFuzzer, AddressSanitizer
+and UndefinedBehaviorSanitizer in build-fuzz/ (the platform and the built-in
+plugins instrumented too), seeds a corpus with every scenario of the config
+corpus (tests/config/cases) and every shipped scenario (scenarios/), copies
+the STL meshes and state files they name into the fuzzer's working folder
+(so relative paths resolve), then runs libFuzzer until --runs executions
+(default 10^6) or --max-time seconds, and prints the executions done, the
+corpus size and every crash, hang or sanitizer report found (files
+crash-*, timeout-*, oom-* in the artefact folder). Each finding belongs in
+tests/config/cases as a corpus case once fixed.
+
+Usage: bench/fuzz_scenarios.py [--runs N] [--max-time S] [--jobs J] [--work DIR]
+Needs clang (Debian's clang package has libFuzzer).
+"""
+import argparse
+import glob
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def build(build_dir):
+    env = dict(os.environ, CC="clang", CXX="clang++")
+    subprocess.run(["cmake", "-S", ROOT, "-B", build_dir, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=RelWithDebInfo",
+                    "-DDOMEL_FUZZ=ON", "-DDOMEL_SANITIZE=address,undefined", "-DDOMEL_BUILD_TESTS=OFF"],
+                   check=True, env=env, stdout=subprocess.DEVNULL)
+    subprocess.run(["cmake", "--build", build_dir, "--target", "domel_scenario_fuzz", "domel_contact_std",
+                    "domel_controller_std", "domel_fluid_std", "domel_insertion_std", "domel_rolling_std"],
+                   check=True, env=env)
+    return os.path.join(build_dir, "tests", "fuzz", "domel_scenario_fuzz")
+
+
+def seed_corpus(corpus, workdir):
+    os.makedirs(corpus, exist_ok=True)
+    os.makedirs(workdir, exist_ok=True)
+    seeds = sorted(glob.glob(os.path.join(ROOT, "tests", "config", "cases", "*.json")) +
+                   glob.glob(os.path.join(ROOT, "scenarios", "**", "*.json"), recursive=True))
+    for k, f in enumerate(seeds):
+        shutil.copy(f, os.path.join(corpus, "seed_%03d_%s" % (k, os.path.basename(f))))
+    # files the scenarios name by relative path: meshes and state files
+    for f in (glob.glob(os.path.join(ROOT, "scenarios", "**", "*.stl"), recursive=True) +
+              glob.glob(os.path.join(ROOT, "tests", "config", "cases", "*.stl")) +
+              glob.glob(os.path.join(ROOT, "tests", "config", "cases", "*.csv"))):
+        shutil.copy(f, os.path.join(workdir, os.path.basename(f)))
+    return len(seeds)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--runs", type=int, default=1000000)
+    ap.add_argument("--max-time", type=int, default=0, help="seconds (0: until --runs)")
+    ap.add_argument("--jobs", type=int, default=1, help="parallel fuzzer processes (libFuzzer -workers)")
+    ap.add_argument("--work", default=os.path.join(ROOT, "build-fuzz", "run"))
+    ap.add_argument("--timeout", type=int, default=20, help="seconds one input may take before it counts as a hang")
+    ap.add_argument("--max-len", type=int, default=16384, help="largest input the fuzzer makes, bytes")
+    args = ap.parse_args()
+    if not shutil.which("clang++"):
+        sys.exit("clang++ is needed (apt-get install clang)")
+    fuzzer = build(os.path.join(ROOT, "build-fuzz"))
+    corpus = os.path.join(args.work, "corpus")
+    artefacts = os.path.join(args.work, "artefacts") + os.sep
+    workdir = os.path.join(args.work, "files")
+    os.makedirs(artefacts, exist_ok=True)
+    seeds = seed_corpus(corpus, workdir)
+    env = dict(os.environ, DOMEL_FUZZ_WORKDIR=workdir,
+               ASAN_OPTIONS="detect_leaks=1:abort_on_error=1",
+               LSAN_OPTIONS="suppressions=%s:fast_unwind_on_malloc=0" %
+                            os.path.join(ROOT, "tests", "sanitize", "lsan.supp"),
+               UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+    cmd = [fuzzer, corpus, "-artifact_prefix=" + artefacts, "-timeout=%d" % args.timeout,
+           "-max_len=%d" % args.max_len, "-rss_limit_mb=4096", "-print_final_stats=1",
+           "-dict=" + os.path.join(ROOT, "tests", "fuzz", "scenario.dict")]
+    if args.max_time:
+        cmd.append("-max_total_time=%d" % args.max_time)
+    if args.jobs > 1:
+        per = args.runs // args.jobs
+        cmd += ["-jobs=%d" % args.jobs, "-workers=%d" % args.jobs, "-runs=%d" % per]
+    else:
+        cmd.append("-runs=%d" % args.runs)
+    log = os.path.join(args.work, "fuzz.log")
+    print("fuzzing: %s (log %s)" % (" ".join(cmd), log), flush=True)
+    with open(log, "w") as f:
+        rc = subprocess.call(cmd, stdout=f, stderr=subprocess.STDOUT, env=env, cwd=args.work)
+    text = open(log, errors="replace").read()
+    execs = [int(x) for x in re.findall(r"stat::number_of_executed_units:\s+(\d+)", text)]
+    found = sorted(os.listdir(artefacts))
+    print("exit code %d; executions %d; seeds %d; corpus now %d files; findings: %s" %
+          (rc, sum(execs), seeds, len(os.listdir(corpus)), ", ".join(found) if found else "none"))
+    return 0 if rc == 0 and not found else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
