@@ -120,6 +120,33 @@ void table(std::ostringstream& os, const json& schema, const json& root) {
   }
 }
 
+/// The members of an object-valued property, as a table each, one level at
+/// a time down to `depth`: `prefix.name` headings, siblings with the same
+/// schema (a box's six sides) under one heading.
+void nested_tables(std::ostringstream& os, const json& schema, const json& root, const std::string& prefix,
+                   int depth) {
+  const json& s = resolve(schema, root);
+  if (depth <= 0 || !s.contains("properties")) return;
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups;  // schema text -> names
+  for (const auto& [name, prop] : s["properties"].items()) {
+    const json& r = resolve(prop, root);
+    if (!r.contains("properties") || r["properties"].empty()) continue;
+    const std::string key = r.dump();
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == key; });
+    if (it == groups.end()) groups.push_back({key, {name}});
+    else it->second.push_back(name);
+  }
+  for (const auto& [key, names] : groups) {
+    std::string heading;
+    for (const auto& n : names) heading += (heading.empty() ? "" : ", ") + std::string("`") + prefix + n + "`";
+    os << "#### " << heading << "\n\n";
+    const json& r = resolve(s["properties"][names[0]], root);
+    if (r.contains("description")) os << r["description"].get<std::string>() << "\n\n";
+    table(os, r, root);
+    nested_tables(os, r, root, prefix + names[0] + ".", depth - 1);
+  }
+}
+
 }  // namespace
 
 std::vector<ParameterRow> parameter_rows(const json& object_schema, const json& root) {
@@ -181,6 +208,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       continue;
     }
     if (std::string(b[0]) == "region") {
+      table(os, s, root);
       os << "### `box`\n\n";
       table(os, s["properties"]["box"], root);
       os << "### `cylinder`\n\n";
@@ -226,7 +254,13 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       if (is_contact_kind(kind)) os << ", per-contact history: " << m.contact.history_slots << " value(s)";
       os << ".\n\n";
       if (m.schema.contains("description")) os << m.schema["description"].get<std::string>() << "\n\n";
-      table(os, m.schema, root);
+      // a plugin's "$ref": "#/$defs/..." point into its own schema
+      json model_root = root;
+      if (m.schema.contains("$defs"))
+        for (const auto& [k, v] : m.schema["$defs"].items())
+          if (!model_root["$defs"].contains(k)) model_root["$defs"][k] = v;
+      table(os, m.schema, model_root);
+      nested_tables(os, m.schema, model_root, "", 3);
     }
     if (kind == DOMEL_KIND_ROLLING || kind == DOMEL_KIND_TWISTING)
       os << (any ? "" : "No model is installed yet. ") << "`{\"model\": \"none\"}` (the default) leaves the slot empty.\n\n";
