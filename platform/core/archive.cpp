@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The checkpoint container (archive.hpp): serialised in memory, checksummed,
-// written through io::write_file_atomically; read whole and verified before
-// any section is handed out.
+// The checkpoint container (archive.hpp): serialised in memory and
+// checksummed; read whole and verified before any section is handed out.
 #include "core/archive.hpp"
 
 #include "core/error.hpp"
-#include "io/atomic_file.hpp"
 
 #include <fstream>
 #include <iterator>
@@ -74,7 +72,7 @@ std::size_t ArchiveWriter::bytes() const {
   return b;
 }
 
-void ArchiveWriter::write(const std::filesystem::path& path, const std::string& header_json) const {
+std::string ArchiveWriter::serialize(const std::string& header_json) const {
   std::string out;
   out.reserve(bytes() + header_json.size() + 64);
   out.append(kMagic, sizeof kMagic);
@@ -91,7 +89,7 @@ void ArchiveWriter::write(const std::filesystem::path& path, const std::string& 
     out += s.data;
   }
   append_raw(out, fnv1a(out.data(), out.size()));
-  io::write_file_atomically(path, out);
+  return out;
 }
 
 void ArchiveReader::fail(const std::string& key, const std::string& what) const {

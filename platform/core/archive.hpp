@@ -41,7 +41,8 @@ constexpr ArchiveType archive_type_of() {
   else static_assert(sizeof(T) == 0, "no archive type for this element type");
 }
 
-/// Collects sections in memory; write() puts the file in place atomically.
+/// Collects sections in memory; serialize() gives the file's bytes (the
+/// caller writes them, atomically: io/atomic_file.hpp; core/ writes no files).
 class ArchiveWriter {
  public:
   template <class T>
@@ -55,9 +56,8 @@ class ArchiveWriter {
   void put_text(const std::string& key, const std::string& text) {
     add(key, ArchiveType::bytes, text.size(), text.data(), text.size());
   }
-  /// Write header and sections to `path` (a temporary name, then renamed).
-  /// Throws RuntimeError naming the path when it cannot be written.
-  void write(const std::filesystem::path& path, const std::string& header_json) const;
+  /// The whole file: header, sections and checksum.
+  std::string serialize(const std::string& header_json) const;
   std::size_t bytes() const;
 
  private:

@@ -3,6 +3,7 @@
 #include "scheduler/checkpoint.hpp"
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scheduler/simulation.hpp"
 
@@ -90,7 +91,7 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k) sim.subdomains[k]->save(w, sd_prefix(k));
   sim.flow.save(w, "flow/");
   if (extra) extra(w);
-  w.write(file, header.dump());
+  io::write_file_atomically(file, w.serialize(header.dump()));
 }
 
 OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simulation& sim) {
