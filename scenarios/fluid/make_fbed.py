@@ -19,6 +19,11 @@ cases (c) and (d), into scenarios/fluid/bed/:
                  cells) with four times the beads (158,464 at alpha = 1): is
                  a difference between the ratios the narrow column's (6
                  parcels across at alpha = 4)?
+  w{1,2,4}.json  the beds of a{1,2,4}.json fluidised by water at U_W m/s
+                 instead of air, for 2 s: a liquid-fluidised bed of these
+                 beads expands homogeneously (no bubbles, no slugs), so its
+                 height is one number to compare across alpha and with the
+                 drag law's own equilibrium.
 
 Every bed is a loose jittered lattice dropped at t = 0 into the rising gas;
 it settles in about 0.2 s. The columns' walls are frictionless for the
@@ -35,6 +40,8 @@ D = 1e-3             # bead diameter [m]
 RHO = 2500.0         # glass [kg/m^3]
 E = 5e6              # Young's modulus [Pa]: S1's material (docs/validation/fluid.md says why)
 RHO_F, MU_F = 1.2, 1.8e-5   # air
+RHO_W, MU_W = 1000.0, 1e-3  # water
+U_W = 0.04           # the water beds: about 5 U_mf (Wen-Yu: 8 mm/s), a third of the beads' terminal velocity [m/s]
 U_MF_SWEEP = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 1.0]   # case (c) [m/s]
 U_D = 1.2            # case (d): about twice U_mf [m/s]
 N_D = 39616          # case (d): beads at alpha = 1 (= 619 x 4^3)
@@ -43,7 +50,7 @@ DT = 5e-6            # DEM step of a 1 mm bead [s]: its Hertz contact time at 1 
 
 
 def scenario(name, description, side, cells_xy, cell_z, height, alpha, count, u, duration,
-             scaling=True, write_interval=0.01, vtk_interval=0.02):
+             scaling=True, write_interval=0.01, vtk_interval=0.02, rho_f=RHO_F, mu_f=MU_F):
     spacing = 1.1
     a = spacing * D * alpha
     return {
@@ -68,7 +75,7 @@ def scenario(name, description, side, cells_xy, cell_z, height, alpha, count, u,
             "model": "vans", "interval": 1e-4,
             "grid": {"min": [0, 0, 0], "max": [side, side, height],
                      "cells": [cells_xy, cells_xy, int(round(height / cell_z))]},
-            "density": RHO_F, "viscosity": MU_F,
+            "density": rho_f, "viscosity": mu_f,
             "drag": {"law": "gidaspow", "coarse_grain_scaling": scaling},
             "boundaries": {s: {"type": "slip_wall"} for s in ("x_min", "x_max", "y_min", "y_max")} | {
                 "z_min": {"type": "velocity_inlet", "velocity": [0, 0, u]},
@@ -109,6 +116,13 @@ def main():
             name, f"Fluidised bed, case (d), twice as wide: {4 * N_D} glass beads of 1 mm as {count} parcels of "
             f"alpha = {alpha}, 48 x 48 mm column, 12 mm cells, air at {U_D} m/s, Gidaspow drag.",
             0.048, 4, 0.012, 0.24, alpha, count, U_D, 0.8)
+    for alpha in (1, 2, 4):
+        name = f"w{alpha}"
+        count = N_D // alpha ** 3
+        docs[name] = scenario(
+            name, f"Liquid-fluidised bed, case (d): {N_D} glass beads of 1 mm as {count} parcels of alpha = {alpha}, "
+            f"24 x 24 mm column, 12 mm cells, water at {U_W} m/s, Gidaspow drag.",
+            0.024, 2, 0.012, 0.24, alpha, count, U_W, 2.0, rho_f=RHO_W, mu_f=MU_W)
     for name, doc in docs.items():
         with open(os.path.join(out, name + ".json"), "w") as f:
             json.dump(doc, f, indent=1)
