@@ -328,8 +328,9 @@ TEST_F(Cli, SigintWritesACheckpointAndTheRestartEndsLikeAnUninterruptedRun) {
     execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
-  // wait until it has written a few frames (it takes about 4 s in all)
-  for (int k = 0; k < 200 && !fs::exists(cut / "particles_000003.vtp"); ++k) usleep(20000);
+  // wait until it has written a few frames (it takes about 4 s in all, many
+  // times that under the sanitizers), so that the handler is installed
+  for (int k = 0; k < 3000 && !fs::exists(cut / "particles_000003.vtp"); ++k) usleep(20000);
   kill(pid, SIGINT);
   int status = 0;
   waitpid(pid, &status, 0);
