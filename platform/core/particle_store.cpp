@@ -91,13 +91,20 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
 
 namespace domel::platform {
 
+namespace {
+/// The store's double arrays with their section names, for save() and load() alike.
+const std::pair<const char*, std::vector<double> ParticleStore::*> kRealArrays[] = {
+    {"x", &ParticleStore::x}, {"y", &ParticleStore::y}, {"z", &ParticleStore::z}, {"vx", &ParticleStore::vx},
+    {"vy", &ParticleStore::vy}, {"vz", &ParticleStore::vz}, {"wx", &ParticleStore::wx}, {"wy", &ParticleStore::wy},
+    {"wz", &ParticleStore::wz}, {"fx", &ParticleStore::fx}, {"fy", &ParticleStore::fy}, {"fz", &ParticleStore::fz},
+    {"tx", &ParticleStore::tx}, {"ty", &ParticleStore::ty}, {"tz", &ParticleStore::tz},
+    {"radius", &ParticleStore::radius}, {"mass", &ParticleStore::mass}, {"inv_mass", &ParticleStore::inv_mass},
+    {"inv_inertia", &ParticleStore::inv_inertia}};
+}  // namespace
+
 void ParticleStore::save(ArchiveWriter& w, const std::string& p) const {
   w.put(p + "id", id);
-  const std::pair<const char*, const std::vector<double>*> reals[] = {
-      {"x", &x}, {"y", &y}, {"z", &z}, {"vx", &vx}, {"vy", &vy}, {"vz", &vz}, {"wx", &wx}, {"wy", &wy},
-      {"wz", &wz}, {"fx", &fx}, {"fy", &fy}, {"fz", &fz}, {"tx", &tx}, {"ty", &ty}, {"tz", &tz},
-      {"radius", &radius}, {"mass", &mass}, {"inv_mass", &inv_mass}, {"inv_inertia", &inv_inertia}};
-  for (const auto& [name, v] : reals) w.put(p + name, *v);
+  for (const auto& [name, member] : kRealArrays) w.put(p + name, this->*member);
   w.put(p + "contacts", contacts);
   w.put(p + "flags", flags);
   w.put_scalar<std::uint8_t>(p + "external_force", external_force_ ? 1 : 0);
@@ -113,11 +120,7 @@ void ParticleStore::save(ArchiveWriter& w, const std::string& p) const {
 
 void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
   r.get_into(p + "id", id);
-  const std::pair<const char*, std::vector<double>*> reals[] = {
-      {"x", &x}, {"y", &y}, {"z", &z}, {"vx", &vx}, {"vy", &vy}, {"vz", &vz}, {"wx", &wx}, {"wy", &wy},
-      {"wz", &wz}, {"fx", &fx}, {"fy", &fy}, {"fz", &fz}, {"tx", &tx}, {"ty", &ty}, {"tz", &tz},
-      {"radius", &radius}, {"mass", &mass}, {"inv_mass", &inv_mass}, {"inv_inertia", &inv_inertia}};
-  for (const auto& [name, v] : reals) r.get_into(p + name, *v);
+  for (const auto& [name, member] : kRealArrays) r.get_into(p + name, this->*member);
   r.get_into(p + "contacts", contacts);
   r.get_into(p + "flags", flags);
   external_force_ = r.scalar<std::uint8_t>(p + "external_force") != 0;

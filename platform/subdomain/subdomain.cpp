@@ -484,7 +484,7 @@ void Subdomain::save(ArchiveWriter& w, const std::string& p) {
                                          forces_time_});
   w.put(p + "counters", std::vector<std::uint64_t>{steps_, last_contacts_, last_wall_contacts_, builds_since_reorder_,
                                                    reordered_size_, far_active_ ? 1u : 0u,
-                                                   walls_force_rebuild_ ? 1u : 0u, reorder_every_});
+                                                   walls_force_rebuild_ ? 1u : 0u});
 }
 
 bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
@@ -492,7 +492,7 @@ bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
   const auto reals = r.get<double>(p + "reals");
   const auto counters = r.get<std::uint64_t>(p + "counters");
   if (reals.size() != 7) r.fail(p + "reals", "holds " + std::to_string(reals.size()) + " values, expected 7");
-  if (counters.size() != 8) r.fail(p + "counters", "holds " + std::to_string(counters.size()) + " values, expected 8");
+  if (counters.size() != 7) r.fail(p + "counters", "holds " + std::to_string(counters.size()) + " values, expected 7");
   if (reals[1] != dt_)
     r.fail(p + "reals", "was written with a time step of " + std::to_string(reals[1]) + " s; subdomain '" + name_ +
                             "' now steps " + std::to_string(dt_) + " s");
