@@ -119,6 +119,18 @@ class UniformStokes {
     for (int d = 0; d < 3; ++d) g_[d] = gravity[d];
   }
 
+  // Checkpoints (ABI 2.3): what the next call depends on that the
+  // parameters do not give: the gravity learnt at the last exchange (the
+  // fields use it) and whether the Reynolds warning was given.
+  void save_state(domel::sdk::StateWriter& w) const {
+    for (double g : g_) w.put(g);
+    w.put(static_cast<unsigned char>(warned_));
+  }
+  void load_state(domel::sdk::StateReader& r) {
+    for (double& g : g_) g = r.get<double>();
+    warned_ = r.get<unsigned char>() != 0;
+  }
+
   void fields(domel_fluid_fields_v1& out) {
     const size_t cells = static_cast<size_t>(n_[0]) * n_[1] * n_[2];
     velocity_.assign(3 * cells, 0.0);

@@ -50,6 +50,9 @@
 
 namespace domel::platform {
 
+class ArchiveWriter;
+class ArchiveReader;
+
 namespace io {
 class CsvSeries;
 class CellGridVtkSeries;
@@ -150,6 +153,17 @@ class Coupling {
                 const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
   /// Grid files due at t (or the last ones when final).
   void write_grids(double t, bool final);
+  /// Checkpoints (docs/checkpoint.md), written at a macro-step start before
+  /// the exchange: both grids' averages, every face's books and queue, the
+  /// parcels followed and those already counted, the insertion RNG, the
+  /// counters and outflow books, the controllers' states (ABI 2.3
+  /// save_state) and how far the balance and grid files got.
+  void save(ArchiveWriter& w, const std::string& prefix);
+  /// After start() on a restart: every value replaced by the checkpoint's,
+  /// the files continued. Throws ConfigError naming the section when the
+  /// checkpoint holds another coupling.
+  void load(const ArchiveReader& r, const std::string& prefix);
+
   /// Close the balance file and describe the coupling for summary.json.
   nlohmann::json summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleFlow& flow);
 

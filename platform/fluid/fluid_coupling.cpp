@@ -5,6 +5,7 @@
 #include "fluid/fluid_coupling.hpp"
 
 #include "core/abi_views.hpp"
+#include "core/archive.hpp"
 #include "core/error.hpp"
 #include "core/particle_store.hpp"
 #include "io/cell_grid_output.hpp"
@@ -123,6 +124,7 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
     if (spec_.model->fluid_limits(lim)) {
       has_limits_ = true;
       last_limits_ = lim;
+      last_limit_ = lim.limit ? lim.limit : "";
     }
   } catch (const PluginError& e) {
     std::ostringstream os;
@@ -135,7 +137,7 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
     std::ostringstream os;
     os << spec_.where << "/interval: the coupling interval " << spec_.interval
        << " s is longer than the fluid's stable interval " << last_limits_.max_interval << " s at t = " << t
-       << " s (" << (last_limits_.limit ? last_limits_.limit : "the coupler's stability limit")
+       << " s (" << (last_limit_.empty() ? std::string("the coupler's stability limit") : last_limit_)
        << "); shorten the interval";
     throw RuntimeError(os.str());
   }
@@ -207,6 +209,44 @@ void FluidCoupling::write_fields(double t, bool final, const std::filesystem::pa
   fields_out_->write(t, image);
 }
 
+void FluidCoupling::save(ArchiveWriter& w, const std::string& p) const {
+  const auto bytes = spec_.model->save_state();
+  w.put_text(p + "coupler_state", std::string(bytes.begin(), bytes.end()));
+  w.put(p + "counts", std::vector<std::uint64_t>{exchanges_, has_limits_ ? 1u : 0u, last_limits_.solver_iterations,
+                                                 spec_.levels.size()});
+  std::vector<double> reals = {seconds_, next_write_, last_limits_.max_interval, last_limits_.solver_residual};
+  for (const auto& f : net_force_) reals.insert(reals.end(), f.begin(), f.end());
+  w.put(p + "reals", reals);
+  w.put_text(p + "limit", last_limit_);
+  w.put(p + "field_times", fields_out_ ? fields_out_->frame_times() : std::vector<double>{});
+}
+
+void FluidCoupling::load(const ArchiveReader& r, const std::string& p, const std::filesystem::path& out) {
+  const std::string bytes = r.text(p + "coupler_state");
+  try {
+    spec_.model->load_state(std::vector<unsigned char>(bytes.begin(), bytes.end()));
+  } catch (const PluginError& e) {
+    r.fail(p + "coupler_state", std::string("holds a state the fluid coupler refuses: ") + e.what());
+  }
+  const auto n = r.get<std::uint64_t>(p + "counts");
+  const auto v = r.get<double>(p + "reals");
+  if (n.size() != 4 || n[3] != spec_.levels.size() || v.size() != 4 + 3 * spec_.levels.size())
+    r.fail(p + "counts", "does not hold the state of a fluid shared by " + std::to_string(spec_.levels.size()) +
+                             " level(s)");
+  exchanges_ = n[0];
+  has_limits_ = n[1] != 0;
+  last_limits_.solver_iterations = static_cast<uint32_t>(n[2]);
+  seconds_ = v[0], next_write_ = v[1], last_limits_.max_interval = v[2], last_limits_.solver_residual = v[3];
+  for (std::size_t L = 0; L < net_force_.size(); ++L)
+    for (int d = 0; d < 3; ++d) net_force_[L][d] = v[4 + 3 * L + d];
+  last_limit_ = r.text(p + "limit");
+  const auto times = r.get<double>(p + "field_times");
+  if (!times.empty()) {
+    fields_out_ = std::make_unique<io::FieldImageSeries>(out, "fluid");
+    fields_out_->resume(times);
+  }
+}
+
 nlohmann::json FluidCoupling::summary() const {
   nlohmann::json levels = nlohmann::json::array();
   for (std::size_t L = 0; L < spec_.levels.size(); ++L)
@@ -220,7 +260,7 @@ nlohmann::json FluidCoupling::summary() const {
                       {"levels", levels}};
   if (has_limits_)
     j["limits"] = {{"max_interval_s", last_limits_.max_interval},
-                   {"limit", last_limits_.limit ? last_limits_.limit : ""},
+                   {"limit", last_limit_},
                    {"solver_iterations", last_limits_.solver_iterations},
                    {"solver_residual", last_limits_.solver_residual}};
   if (fields_out_) j["fields"] = "fluid.pvd";

@@ -32,6 +32,9 @@ namespace domel::platform {
 
 class Subdomain;
 
+class ArchiveWriter;
+class ArchiveReader;
+
 namespace io {
 class FieldImageSeries;
 }
@@ -74,6 +77,14 @@ class FluidCoupling {
   /// the interval) into <out>/fluid_<NNNNNN>.vti and fluid.pvd.
   void write_fields(double t, bool final, const std::filesystem::path& out);
 
+  /// Checkpoints (docs/checkpoint.md): the coupler's state (ABI 2.3
+  /// save_state), the exchange count, the last limits, the fields' schedule
+  /// and frames. The per-particle arrays (drag, held force, velocity
+  /// integrals) are the particle store's and saved with it.
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  /// On a restart, before the first exchange; `out` is the run's folder.
+  void load(const ArchiveReader& r, const std::string& prefix, const std::filesystem::path& out);
+
   /// summary.json's "fluid" block: model, levels, interval, exchanges, time
   /// spent in the plugin, the last limit and solver figures, the net fluid
   /// force on each level at the last exchange.
@@ -92,6 +103,7 @@ class FluidCoupling {
   double next_write_ = 0;
   bool has_limits_ = false;
   domel_fluid_limits_v1 last_limits_{};
+  std::string last_limit_;  ///< last_limits_.limit's text
   std::vector<std::array<double, 3>> net_force_;  ///< per level, at the last exchange [N]
   std::unique_ptr<io::FieldImageSeries> fields_out_;
 };

@@ -75,6 +75,9 @@ class FieldImageSeries {
   /// when a file cannot be written. Returns the path of the .vti.
   std::filesystem::path write(double time, const FieldImage& image);
   std::size_t files_written() const { return frames_.size(); }
+  /// The frames so far, and a restart's continuation of them (VtkFrames).
+  std::vector<double> frame_times() const { return frames_.times(); }
+  void resume(const std::vector<double>& times) { frames_.resume(times); }
 
  private:
   std::filesystem::path directory_;

@@ -381,6 +381,47 @@ bool ModelInstance::fluid_limits(domel_fluid_limits_v1& out) const {
   return true;
 }
 
+namespace {
+
+/// The save_state and load_state of the instance's family (null if none).
+std::pair<domel_save_state_fn, domel_load_state_fn> state_callbacks(const RegisteredModel& m) {
+  if (m.desc.kind == DOMEL_KIND_CONTROLLER) return {m.controller.save_state, m.controller.load_state};
+  if (m.desc.kind == DOMEL_KIND_FLUID_COUPLER) return {m.fluid_coupler.save_state, m.fluid_coupler.load_state};
+  return {nullptr, nullptr};
+}
+
+}  // namespace
+
+bool ModelInstance::has_state() const {
+  const auto [save, load] = state_callbacks(*model_);
+  return save != nullptr && load != nullptr;
+}
+
+std::vector<unsigned char> ModelInstance::save_state() const {
+  const auto [save, load] = state_callbacks(*model_);
+  (void)load;
+  if (save == nullptr) throw PluginError(host_->prefix + ": cannot save its state (no save_state, ABI 2.3)");
+  std::vector<unsigned char> bytes;
+  domel_state_sink_v1 sink{sizeof(domel_state_sink_v1), 0, &bytes, [](void* host, const void* data, size_t n) {
+                             auto* out = static_cast<std::vector<unsigned char>*>(host);
+                             if (n > 0 && data == nullptr) return DOMEL_ERR_RUNTIME;
+                             const auto* p = static_cast<const unsigned char*>(data);
+                             out->insert(out->end(), p, p + n);
+                             return DOMEL_OK;
+                           }};
+  char err[1024] = {0};
+  if (save(handle_, &sink, err, sizeof err) != DOMEL_OK) fail("save_state", err);
+  return bytes;
+}
+
+void ModelInstance::load_state(const std::vector<unsigned char>& bytes) const {
+  const auto [save, load] = state_callbacks(*model_);
+  (void)save;
+  if (load == nullptr) throw PluginError(host_->prefix + ": cannot load a state (no load_state, ABI 2.3)");
+  char err[1024] = {0};
+  if (load(handle_, bytes.data(), bytes.size(), err, sizeof err) != DOMEL_OK) fail("load_state", err);
+}
+
 void ModelInstance::insert(const domel_insert_request_v1& request, std::vector<double>& x,
                            std::vector<double>& y, std::vector<double>& z, std::vector<double>& r) const {
   std::size_t capacity = 4096;

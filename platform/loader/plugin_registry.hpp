@@ -128,6 +128,15 @@ class ModelInstance {
   bool fluid_fields(domel_fluid_fields_v1& out) const;
   /// A fluid coupler's stability limit (false: it reports none).
   bool fluid_limits(domel_fluid_limits_v1& out) const;
+  /// Whether a controller or fluid coupler can save and load its state
+  /// (ABI 2.3's optional save_state and load_state, both present).
+  bool has_state() const;
+  /// Its state for a checkpoint; throws PluginError when it fails or has no
+  /// save_state.
+  std::vector<unsigned char> save_state() const;
+  /// Restore a state save_state() gave (on a fresh instance); a refusal
+  /// throws PluginError with the plugin's message.
+  void load_state(const std::vector<unsigned char>& bytes) const;
 
   struct HostContext;  ///< the instance's side of domel_host_v2 (plugin_registry.cpp)
 

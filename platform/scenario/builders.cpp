@@ -88,6 +88,7 @@ void build_run(Build& b) {
   // no schema default: absent means $DOMEL_THREADS, else 1, decided at run time (Simulation::run)
   b.sim.threads = run.contains("threads") ? run["threads"].get<int>() : 0;
   b.sim.checkpoint_interval = run["checkpoint_interval"].get<double>();
+  b.sim.flow.max_particles = run["max_particles"].get<std::size_t>();
   b.sim.document = b.doc;
 }
 
@@ -135,6 +136,12 @@ void check_initial_particles(Build& b, const Subdomain& sub, const json& sd, con
   const ParticleStore& s = const_cast<Subdomain&>(sub).store();
   const std::string name = sd["name"].get<std::string>();
   const std::string source = sd.contains("initial_state") ? base + "/initial_state" : base + "/insert";
+  if (b.sim.flow.max_particles != 0 && s.size() > b.sim.flow.max_particles) {
+    b.ck.add(source, "the subdomain starts with " + std::to_string(s.size()) + " particles, more than run.max_particles (" +
+                         std::to_string(b.sim.flow.max_particles) + ")",
+             "check the units of the regions and diameters, or raise /run/max_particles");
+    return;
+  }
   const double limit = b.doc["run"]["max_initial_overlap"].get<double>();
   const InitialOverlaps o = find_initial_overlaps(s, limit);
   if (o.pairs > 0)
@@ -262,7 +269,8 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
     try {
       const Inserter ins = make_inserter(b, block, sub.name(), b.sim.seed * 1000003ull + hash + q);
       ParticleStore& st = sub.store();
-      const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st);
+      const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
+                                                               b.sim.flow.max_particles);
       st.reserve(st.size() + c.size());
       for (std::size_t p = 0; p < c.size(); ++p) {
         st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], density, ins.fixed);
@@ -321,7 +329,7 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
           p.interval = 0.01;
         }
       }
-      const InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr);
+      const InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr, b.sim.flow.max_particles);
       if (c.size() == 0) {
         b.ck.add(where + "/insert", "the insertion model placed no particle in the pour region",
                  "enlarge the region or raise the model's volume_fraction / count");
@@ -1098,6 +1106,12 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   if (fluid) {
     if (fluid->write_interval < 0) fluid->write_interval = sim->vtk_interval;
     sim->fluid = std::make_unique<FluidCoupling>(std::move(*fluid), sim->subdomains);
+  }
+  if (sim->checkpoint_interval > 0) {
+    const std::string why = sim->why_no_checkpoint();
+    if (!why.empty())
+      throw ConfigError({Diagnostic{file.string(), "/run/checkpoint_interval", why,
+                                    "remove run.checkpoint_interval, or rebuild the plugin against the SDK of ABI 2.3"}});
   }
   return sim;
 }

@@ -33,7 +33,7 @@ double mass_kg(MassUnits u) {
 }
 
 InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
-                                      double alpha, const ParticleStore* present) {
+                                      double alpha, const ParticleStore* present, std::size_t max_count) {
   domel_insert_request_v1 req{};
   req.struct_size = sizeof(req);
   req.region = region;
@@ -44,8 +44,15 @@ InsertionCandidates request_insertion(const ModelInstance& model, const domel_re
     req.ex_x = present->x.data(); req.ex_y = present->y.data(); req.ex_z = present->z.data();
     req.ex_r = present->radius.data();
   }
+  req.max_count = max_count;
   InsertionCandidates c;
   model.insert(req, c.x, c.y, c.z, c.r);
+  // a model of ABI 2.2 does not know max_count: the host refuses afterwards
+  if (max_count != 0 && c.size() > max_count)
+    throw PluginError(model.context() + ": the insertion placed " + std::to_string(c.size()) +
+                      " particles, more than the " + std::to_string(max_count) +
+                      " the run accepts (run.max_particles): check the units of the region and of the diameters, "
+                      "or raise run.max_particles");
   return c;
 }
 
@@ -106,7 +113,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   const std::uint64_t seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
   InsertionCandidates c;
   try {
-    c = request_insertion(*p.model, p.region, seed, p.alpha, &st);
+    c = request_insertion(*p.model, p.region, seed, p.alpha, &st, max_particles);
   } catch (const PluginError& e) {
     throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
   }
@@ -293,9 +300,7 @@ nlohmann::json ParticleFlow::summary(const std::vector<std::unique_ptr<Subdomain
 
 namespace domel::platform {
 
-namespace {
-
-void put_units(ArchiveWriter& w, const std::string& key, const std::vector<MassUnits>& v) {
+void put_mass_units(ArchiveWriter& w, const std::string& key, const std::vector<MassUnits>& v) {
   std::vector<std::uint64_t> halves;
   for (MassUnits u : v) {
     const auto bits = static_cast<unsigned __int128>(u);
@@ -305,7 +310,7 @@ void put_units(ArchiveWriter& w, const std::string& key, const std::vector<MassU
   w.put(key, halves);
 }
 
-std::vector<MassUnits> get_units(const ArchiveReader& r, const std::string& key) {
+std::vector<MassUnits> get_mass_units(const ArchiveReader& r, const std::string& key) {
   const auto halves = r.get<std::uint64_t>(key);
   if (halves.size() % 2) r.fail(key, "does not hold pairs of 64-bit halves");
   std::vector<MassUnits> v;
@@ -313,6 +318,8 @@ std::vector<MassUnits> get_units(const ArchiveReader& r, const std::string& key)
     v.push_back(static_cast<MassUnits>((static_cast<unsigned __int128>(halves[k + 1]) << 64) | halves[k]));
   return v;
 }
+
+namespace {
 
 void put_series(ArchiveWriter& w, const std::string& p, const FlowSeries& s) {
   w.put(p + "series_t", s.t);
@@ -335,7 +342,7 @@ void ParticleFlow::save(ArchiveWriter& w, const std::string& p) const {
     units.insert(units.end(), {a.inserted, a.removed});
     counts.insert(counts.end(), {a.n_inserted, a.n_removed});
   }
-  put_units(w, p + "accounts_units", units);
+  put_mass_units(w, p + "accounts_units", units);
   w.put(p + "accounts_counts", counts);
   w.put_scalar<std::uint64_t>(p + "checks", checks_.index());
   w.put(p + "last_row", std::vector<double>(1, last_row_t_));
@@ -388,7 +395,7 @@ void ParticleFlow::restore(const ArchiveReader& r, const std::string& p,
                       " (a restart keeps the particle flow of the checkpointed run)");
   };
   next_id = r.scalar<std::uint64_t>(p + "next_id");
-  const auto units = get_units(r, p + "accounts_units");
+  const auto units = get_mass_units(r, p + "accounts_units");
   const auto counts = r.get<std::uint64_t>(p + "accounts_counts");
   if (units.size() != 2 * accounts_.size() || counts.size() != 2 * accounts_.size())
     r.fail(p + "accounts_units", "holds the books of another number of subdomains");

@@ -43,14 +43,19 @@ struct InsertionCandidates {
 /// The one way the platform asks an insertion model for particles, for the
 /// start-up insertion and for pours alike: fill `region` with the model's
 /// particles, radii scaled by alpha, avoiding the particles of `present`
-/// (none when null), with `seed`. Throws PluginError when the model fails.
+/// (none when null), with `seed`, at most `max_count` of them (the
+/// scenario's run.max_particles; 0: no limit). Throws PluginError when the
+/// model fails or would place more.
 InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
-                                      double alpha, const ParticleStore* present);
+                                      double alpha, const ParticleStore* present, std::size_t max_count);
 
 /// Exact mass in units of 1e-18 kg (sums in 128 bits).
 using MassUnits = __int128;
 MassUnits mass_units(double kg);
 double mass_kg(MassUnits u);
+/// Exact books in a checkpoint: each value as two 64-bit halves.
+void put_mass_units(ArchiveWriter& w, const std::string& key, const std::vector<MassUnits>& v);
+std::vector<MassUnits> get_mass_units(const ArchiveReader& r, const std::string& key);
 
 struct MassAccount {
   MassUnits inserted = 0;
@@ -121,6 +126,7 @@ class ParticleFlow {
   std::vector<MassFlowPlane> planes;
   double deletion_interval = 0;  ///< [s] between deletion (and plane) checks: run.deletion_interval
   std::uint64_t next_id = 1;     ///< id of the next inserted particle
+  std::size_t max_particles = 0; ///< the most one insertion may place (run.max_particles; 0: no limit)
 
   bool empty() const { return pours.empty() && deletions.empty() && planes.empty() && !external_; }
 

@@ -100,25 +100,34 @@ std::string probe_column_unit(const std::string& column) {
   return "";
 }
 
+std::string Simulation::why_no_checkpoint() const {
+  const ModelInstance* stateless = nullptr;
+  for (const auto& c : couplings)
+    for (const ControllerSetup* cs : {&c->spec().stress, &c->spec().velocity})
+      if (!stateless && cs->enabled && !cs->model->has_state()) stateless = cs->model.get();
+  if (!stateless && fluid && !fluid->spec().model->has_state()) stateless = fluid->spec().model.get();
+  if (!stateless) return "";
+  return stateless->context() + " cannot save its state (its library lacks ABI 2.3's save_state and load_state, "
+                                "docs/sdk-guide.md), so this run cannot be checkpointed";
+}
+
 RunResult Simulation::run(const RunOptions& options, const PluginRegistry& registry) {
   RunResult result;
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
   // A restart is checked against this scenario before anything is written.
+  const std::string why_not = why_no_checkpoint();
+  const bool checkpoints_possible = why_not.empty();
   std::optional<OpenedCheckpoint> ck;
   if (!options.restart.empty()) {
-    if (!couplings.empty() || fluid)
-      throw ConfigError({Diagnostic{scenario_file.string(), "",
-                                    "a restart does not yet cover couplings or the fluid block, whose state "
-                                    "checkpoints do not hold yet (docs/checkpoint.md)", ""}});
+    if (!checkpoints_possible)
+      throw ConfigError({Diagnostic{scenario_file.string(), "", "cannot restart: " + why_not, ""}});
     ck = open_checkpoint(options.restart, *this);
     for (const auto& c : ck->allowed_changes) spdlog::info("restart: scenario changed, allowed: {}", c);
   }
-  const bool checkpoints_possible = couplings.empty() && !fluid;
   if (checkpoint_interval > 0 && !checkpoints_possible)
     throw ConfigError({Diagnostic{scenario_file.string(), "/run/checkpoint_interval",
-                                  "checkpoints do not yet cover couplings or the fluid block (docs/checkpoint.md); "
-                                  "remove run.checkpoint_interval", ""}});
+                                  why_not + "; remove run.checkpoint_interval", ""}});
   std::filesystem::create_directories(out);
   io::ManifestScope manifest(out);  // lists every file written below (io/output_folder.hpp)
   const int threads_requested =
@@ -325,6 +334,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
         if (files[1] > 0) grid_csv[g]->resume(files[1]);
       }
     }
+    for (std::size_t k = 0; k < couplings.size(); ++k) couplings[k]->load(r, "coupling" + std::to_string(k) + "/");
+    if (fluid) fluid->load(r, "fluid/", out);
     // the walls' activity as the run last looked at it (refresh_accessible)
     for (std::size_t w = 0; w < walls.size(); ++w) wall_active[w] = walls[w].active(t_before >= 0 ? t_before : 0.0) ? 1 : 0;
   }
@@ -353,6 +364,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
         w.put_scalar(p + "write_interval", grid_files[g].period());
         w.put(p + "vtk_times", grid_vtk[g] ? grid_vtk[g]->frame_times() : std::vector<double>{});
       }
+      for (std::size_t k = 0; k < couplings.size(); ++k) couplings[k]->save(w, "coupling" + std::to_string(k) + "/");
+      if (fluid) fluid->save(w, "fluid/");
     });
     spdlog::debug("checkpoint at t = {:.6g} s written in {:.3g} s", ls.time,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -385,7 +398,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       // probes.csv and the other files end where the checkpoint does
       if (options.checkpoint_on_signal && checkpoints_possible) save_checkpoint(m);
       else if (options.checkpoint_on_signal)
-        spdlog::warn("no checkpoint: checkpoints do not yet cover couplings or the fluid block");
+        spdlog::warn("no checkpoint: {}", why_not);
       break;
     }
     if (m < stop && !run_hooks.before.empty()) {

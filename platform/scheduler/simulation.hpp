@@ -113,6 +113,10 @@ class Simulation {
   /// file written up to then is complete (written to a temporary name and renamed).
   RunResult run(const RunOptions& options, const PluginRegistry& registry);
 
+  /// Why this run cannot be checkpointed ("" if it can): a controller or
+  /// fluid coupler whose library lacks ABI 2.3's save_state and load_state.
+  std::string why_no_checkpoint() const;
+
   /// The macro step and each subdomain's number of sub-steps within it.
   double macro_step() const;
 };

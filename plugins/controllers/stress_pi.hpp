@@ -71,7 +71,7 @@ class StressPi {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_CONTROLLER;
   static constexpr const char* kName = "stress_pi";
-  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kVersion = "1.1.0";
   static constexpr const char* kSummary =
       "PI stress controller on the fine region's boundary cells: pushes levels[0] (FINE) particles so their normal "
       "stress matches levels[1] (COARSE) in the congruent cell (grids of both levels must match)";
@@ -247,6 +247,32 @@ class StressPi {
     if (depth <= (1.0 - fade) * used) return 1.0;
     const double s = std::sin(0.5 * kPi * (used - depth) / (fade * used));
     return s * s;
+  }
+
+  /// Checkpoints (abi.h, ABI 2.3): per controlled cell the integral, the
+  /// previous PV and whether there is one, and the last call's outcome and
+  /// figures (what state() shows).
+  void save_state(sdk::StateWriter& w) const {
+    w.put<std::uint64_t>(state_.size());
+    for (const StressPiCellState& s : state_) {
+      w.put(s.integral), w.put(s.pv_old), w.put(s.has_pv_old), w.put(s.outcome);
+      w.put(s.setpoint), w.put(s.process), w.put(s.error), w.put(s.command), w.put(s.pushed);
+      w.put(s.applied_mean), w.put(s.unwound);
+    }
+  }
+  void load_state(sdk::StateReader& r) {
+    const auto n = r.get<std::uint64_t>();
+    if (n != state_.size())
+      throw std::runtime_error("the saved state has " + std::to_string(n) + " cells, this controller controls " +
+                               std::to_string(state_.size()));
+    for (StressPiCellState& s : state_) {
+      s.integral = r.get<decltype(s.integral)>(), s.pv_old = r.get<decltype(s.pv_old)>();
+      s.has_pv_old = r.get<decltype(s.has_pv_old)>(), s.outcome = r.get<StressPiOutcome>();
+      s.setpoint = r.get<decltype(s.setpoint)>(), s.process = r.get<decltype(s.process)>();
+      s.error = r.get<decltype(s.error)>(), s.command = r.get<decltype(s.command)>();
+      s.pushed = r.get<decltype(s.pushed)>(), s.applied_mean = r.get<decltype(s.applied_mean)>();
+      s.unwound = r.get<decltype(s.unwound)>();
+    }
   }
 
   const std::vector<uint32_t>& cells() const { return cells_; }

@@ -58,7 +58,7 @@ class VelocityP {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_CONTROLLER;
   static constexpr const char* kName = "velocity_p";
-  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kVersion = "1.1.0";
   static constexpr const char* kSummary =
       "P(I) velocity controller of the coarse level over the fine region: drives levels[1] (COARSE) particles "
       "towards levels[0] (FINE) mean velocity in the congruent cell (grids of both levels must match)";
@@ -177,6 +177,29 @@ class VelocityP {
           force[k][i] += f;
         }
       }
+    }
+  }
+
+  /// Checkpoints (abi.h, ABI 2.3): per controlled cell the integral and the
+  /// last call's figures (what state() shows).
+  void save_state(sdk::StateWriter& w) const {
+    w.put<std::uint64_t>(state_.size());
+    for (const VelocityPCellState& s : state_) {
+      w.put(s.integral), w.put(static_cast<std::uint8_t>(s.controlled)), w.put(s.correction);
+      w.put(s.setpoint), w.put(s.process), w.put(s.error), w.put(s.command);
+    }
+  }
+  void load_state(sdk::StateReader& r) {
+    const auto n = r.get<std::uint64_t>();
+    if (n != state_.size())
+      throw std::runtime_error("the saved state has " + std::to_string(n) + " cells, this controller controls " +
+                               std::to_string(state_.size()));
+    for (VelocityPCellState& s : state_) {
+      s.integral = r.get<decltype(s.integral)>();
+      s.controlled = r.get<std::uint8_t>() != 0;
+      s.correction = r.get<double>();
+      s.setpoint = r.get<decltype(s.setpoint)>(), s.process = r.get<decltype(s.process)>();
+      s.error = r.get<decltype(s.error)>(), s.command = r.get<decltype(s.command)>();
     }
   }
 

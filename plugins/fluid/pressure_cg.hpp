@@ -55,6 +55,12 @@ class PressureCg {
     return rep;
   }
 
+  /// The warm start of the next solve (the last correction), for checkpoints.
+  std::vector<double> warm_start() const { return std::vector<double>(last_.data(), last_.data() + last_.size()); }
+  void set_warm_start(const std::vector<double>& x) {
+    last_ = Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size()));
+  }
+
  private:
   double tol_;
   int max_;

@@ -53,6 +53,7 @@ struct PressurePfmg::State {
   HYPRE_StructGrid grid = nullptr;
   HYPRE_StructStencil stencil = nullptr;
   std::vector<double> values, rhs, sol;
+  bool restored = false;  ///< sol came from a checkpoint: the first solve keeps it
   ~State() {
     if (stencil) HYPRE_StructStencilDestroy(stencil);
     if (grid) HYPRE_StructGridDestroy(grid);
@@ -65,6 +66,13 @@ PressurePfmg::PressurePfmg(double tolerance, int max_iterations)
 }
 
 PressurePfmg::~PressurePfmg() = default;
+
+std::vector<double> PressurePfmg::warm_start() const { return s_->sol; }
+
+void PressurePfmg::set_warm_start(const std::vector<double>& x) {
+  s_->sol = x;
+  s_->restored = s_->grid == nullptr;
+}
 
 SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<double>& x) {
   State& s = *s_;
@@ -80,7 +88,8 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     HYPRE_StructStencilCreate(3, 7, &s.stencil);
     for (int e = 0; e < 7; ++e) HYPRE_StructStencilSetElement(s.stencil, e, offsets[e]);
     s.n = sys.n;
-    s.sol.assign(cells, 0.0);
+    if (!s.restored || s.sol.size() != cells) s.sol.assign(cells, 0.0);
+    s.restored = false;
   }
   // the 7-point rows on the whole grid: identity rows for blocked cells
   s.values.assign(7 * cells, 0.0);

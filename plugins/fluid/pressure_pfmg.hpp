@@ -22,6 +22,10 @@ class PressurePfmg {
   PressurePfmg(double tolerance, int max_iterations);
   ~PressurePfmg();
   SolveReport operator()(const PressureSystem& sys, std::vector<double>& x);
+  /// The warm start of the next solve (the last correction on the whole
+  /// grid, empty before the first solve), for checkpoints.
+  std::vector<double> warm_start() const;
+  void set_warm_start(const std::vector<double>& x);
 
  private:
   struct State;

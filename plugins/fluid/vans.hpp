@@ -48,7 +48,7 @@ class Vans {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_FLUID_COUPLER;
   static constexpr const char* kName = "vans";
-  static constexpr const char* kVersion = "0.1.0";
+  static constexpr const char* kVersion = "0.2.0";
   static constexpr const char* kSummary =
       "volume-averaged Navier-Stokes (model A) on a uniform staggered grid, semi-implicit drag, two-way";
   static constexpr const char* kSchema = R"json({
@@ -70,7 +70,16 @@ class Vans {
         "z_min": { "$ref": "#/$defs/side" }, "z_max": { "$ref": "#/$defs/side" } },
       "additionalProperties": false },
     "obstacles": { "type": "array", "default": [], "description": "blocked cells: a box {\"box\": {\"min\", \"max\"}} or a cylinder {\"cylinder\": {\"axis\", \"center\", \"radius\", \"min\", \"max\"}}; a cell is blocked when its centre lies inside, or, along an axis where the shape is thinner than a cell (a plate), when the cell's extent overlaps it",
-      "items": { "type": "object" } },
+      "items": { "oneOf": [
+        { "type": "object", "required": ["box"], "additionalProperties": false, "properties": {
+            "box": { "type": "object", "required": ["min", "max"], "additionalProperties": false, "properties": {
+                "min": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m" }, "max": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m" } } } } },
+        { "type": "object", "required": ["cylinder"], "additionalProperties": false, "properties": {
+            "cylinder": { "type": "object", "required": ["axis", "center", "radius", "min", "max"], "additionalProperties": false, "properties": {
+                "axis": { "enum": ["x", "y", "z"] },
+                "center": { "type": "array", "items": { "type": "number" }, "minItems": 2, "maxItems": 2, "x-unit": "m", "description": "the axis' position in the other two coordinates (x, y for a z axis)" },
+                "radius": { "type": "number", "exclusiveMinimum": 0, "x-unit": "m" },
+                "min": { "type": "number", "x-unit": "m" }, "max": { "type": "number", "x-unit": "m" } } } } } ] } },
     "drag": { "type": "object", "default": {}, "properties": {
         "law": { "enum": ["schiller_naumann", "di_felice", "gidaspow", "beetstra"], "default": "di_felice", "description": "drag law (docs/physics.md §7): schiller_naumann a single sphere; di_felice, gidaspow (Ergun / Wen-Yu) and beetstra for suspensions and beds" },
         "coarse_grain_scaling": { "type": "boolean", "default": true, "description": "a parcel of ratio alpha feels alpha^3 times the drag of one original particle of diameter d/alpha (Sakai & Koshizuka 2009); false: the drag of one sphere of the parcel's diameter (wrong for alpha > 1, for comparison)" } },
@@ -177,6 +186,7 @@ class Vans {
     if (backend == "auto") backend = "pfmg";
     if (backend == "pfmg") {
       auto pfmg = std::make_shared<PressurePfmg>(tol, max_it);
+      pfmg_ = pfmg;
       solve_ = [pfmg](const PressureSystem& sys, std::vector<double>& x) { return (*pfmg)(sys, x); };
     }
 #else
@@ -187,6 +197,7 @@ class Vans {
 #endif
     if (backend == "cg") {
       auto cg = std::make_shared<PressureCg>(tol, max_it);
+      cg_ = cg;
       solve_ = [cg](const PressureSystem& sys, std::vector<double>& x) { return (*cg)(sys, x); };
     }
     backend_ = backend;
@@ -321,6 +332,51 @@ class Vans {
       host_.warn(std::to_string(invalid) + " particle(s) at t = " + std::to_string(ex.time) + " s use the " +
                  name(law_) + " drag law outside the range its source fitted: " + regime);
     }
+  }
+
+  /// Checkpoints (abi.h, ABI 2.3): everything the next exchange reads, so
+  /// that a restarted run goes on bit for bit: the solver's fields, the
+  /// pressure solve's warm start, the exchange count (the first exchange
+  /// differs), the substep count of "auto", the last solve's figures and
+  /// which warnings were given. The layout version comes first.
+  static constexpr std::uint32_t kStateLayout = 1;
+  void save_state(sdk::StateWriter& w) const {
+    w.put(kStateLayout);
+    solver_->save(w);
+    std::vector<double> warm;
+#ifdef DOMEL_HAVE_HYPRE
+    if (pfmg_) warm = pfmg_->warm_start();
+#endif
+    if (cg_) warm = cg_->warm_start();
+    w.put(warm);
+    w.put(exchanges_);
+    w.put(substeps_);
+    w.put(substeps_used_max_);
+    w.put(last_solve_.iterations);
+    w.put(last_solve_.residual);
+    w.put(vmax_);
+    w.put(static_cast<std::uint8_t>(warned_resolution_));
+    w.put(static_cast<std::uint8_t>(warned_validity_));
+  }
+  void load_state(sdk::StateReader& r) {
+    const auto layout = r.get<std::uint32_t>();
+    if (layout != kStateLayout)
+      throw std::runtime_error("the saved state has layout " + std::to_string(layout) + ", this version reads " +
+                               std::to_string(kStateLayout));
+    solver_->load(r);
+    const std::vector<double> warm = r.get_vector<double>();
+#ifdef DOMEL_HAVE_HYPRE
+    if (pfmg_) pfmg_->set_warm_start(warm);
+#endif
+    if (cg_) cg_->set_warm_start(warm);
+    exchanges_ = r.get<std::uint64_t>();
+    substeps_ = r.get<int>();
+    substeps_used_max_ = r.get<int>();
+    last_solve_.iterations = r.get<int>();
+    last_solve_.residual = r.get<double>();
+    vmax_ = r.get<double>();
+    warned_resolution_ = r.get<std::uint8_t>() != 0;
+    warned_validity_ = r.get<std::uint8_t>() != 0;
   }
 
   void fields(domel_fluid_fields_v1& out) {
@@ -591,6 +647,10 @@ class Vans {
   sdk::Host host_;
   std::unique_ptr<VansSolver> solver_;
   PressureSolver solve_;
+#ifdef DOMEL_HAVE_HYPRE
+  std::shared_ptr<PressurePfmg> pfmg_;  ///< the solver behind solve_ (one of the two), for its warm start
+#endif
+  std::shared_ptr<PressureCg> cg_;
   std::string backend_;
   DragLaw law_ = DragLaw::di_felice;
   bool scaling_ = true, pressure_force_ = true, two_way_ = true;

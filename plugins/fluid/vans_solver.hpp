@@ -174,6 +174,37 @@ class VansSolver {
   std::vector<double>& Ku_mut(int a) { return Ku_[a]; }
   std::vector<double>& u_mut(int a) { return u_[a]; }
 
+  /// The state a checkpoint keeps (docs/checkpoint.md): the fields the next
+  /// step starts from (void fraction now and before, pressure, face
+  /// velocities), the last exchange's drag fields (the fields output shows
+  /// them) and the gravity learnt at the first exchange. W and R are the
+  /// SDK's StateWriter and StateReader.
+  template <class W>
+  void save(W& w) const {
+    w.put(eps_);
+    w.put(eps_old_);
+    w.put(p_);
+    for (int a = 0; a < 3; ++a) {
+      w.put(u_[a]);
+      w.put(K_[a]);
+      w.put(Ku_[a]);
+    }
+    w.put(s_.gravity);
+  }
+  template <class R>
+  void load(R& r) {
+    const MacGrid& g = s_.grid;
+    eps_ = r.template get_vector<double>(g.cells());
+    eps_old_ = r.template get_vector<double>(g.cells());
+    p_ = r.template get_vector<double>(g.cells());
+    for (int a = 0; a < 3; ++a) {
+      u_[a] = r.template get_vector<double>(g.faces(a));
+      K_[a] = r.template get_vector<double>(g.faces(a));
+      Ku_[a] = r.template get_vector<double>(g.faces(a));
+    }
+    s_.gravity = r.template get<std::array<double, 3>>();
+  }
+
   /// Remember the current void fraction as eps^n before a new deposit.
   void keep_old_void_fraction() { eps_old_ = eps_; }
 

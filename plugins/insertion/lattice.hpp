@@ -124,6 +124,7 @@ class Lattice {
       sites *= std::max(f, 0.0);
       n[k] = f > 0.0 ? static_cast<long long>(std::min(f, 1e15)) : 0;
     }
+    out.expect(count_ == 0 ? sites : std::min(sites, static_cast<double>(count_)));
     if (count_ == 0 && sites > kMaxSites) {
       std::ostringstream m;
       m << "lattice: the region holds " << sites << " lattice sites of spacing " << a

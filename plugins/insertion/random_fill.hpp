@@ -103,6 +103,7 @@ class RandomFill {
     const double d_lo = d_min_ * alpha, d_hi = d_max_ * alpha;
     const double volume = region_volume(g);
     const std::size_t target = target_count(volume, d_lo, d_hi);
+    out.expect(static_cast<double>(target));
     const Bounds b = region_bounds(g);
 
     const auto nearby = nearby_existing(req, b, 0.5 * d_hi);

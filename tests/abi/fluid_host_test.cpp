@@ -248,3 +248,30 @@ TEST(FluidHost, BadFluidBlocksAreRefusedWithTheirPointers) {
   EXPECT_NE(m.find("at /fluid/subdomains/1: unknown subdomain 'fats' (did you mean 'fast'?)"), std::string::npos)
       << m;
 }
+
+// A coupler built before ABI 2.3 cannot save its state: checkpoints of a run
+// that uses it are refused before anything runs, naming the model and the
+// key, and a restart too (a controller without save_state is refused the
+// same way, Simulation::why_no_checkpoint).
+TEST(FluidHost, ACouplerThatCannotSaveItsStateRefusesCheckpointsNamingIt) {
+  json doc = scenario({{"model", "abi21_push"}, {"interval", 1e-3}}, 1e-3);
+  doc["run"]["checkpoint_interval"] = 5e-4;
+  const std::string msg = config_error(doc);
+  EXPECT_NE(msg.find("/run/checkpoint_interval"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'abi21_push'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("save_state"), std::string::npos) << msg;
+  doc["run"].erase("checkpoint_interval");
+  auto sim = dp::load_scenario(doc, "fluid.json", registry());
+  dp::RunOptions o;
+  o.output_directory = out_dir("nostate");
+  o.progress = false;
+  o.restart = out_dir("nostate") / "checkpoint.ckpt";
+  try {
+    sim->run(o, registry());
+    ADD_FAILURE() << "a restart of a run whose coupler cannot load its state ran";
+  } catch (const dp::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot restart"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'abi21_push'"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(out_dir("nostate"));
+}

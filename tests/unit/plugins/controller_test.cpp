@@ -898,3 +898,53 @@ TEST(ControllerLibrary, LoadsThroughThePluginRegistry) {
     EXPECT_NE(std::string(e.what()).find("needs exactly 2 levels"), std::string::npos) << e.what();
   }
 }
+
+// Checkpoints (ABI 2.3): a state saved after one call and loaded into a
+// fresh instance makes the second call give exactly what the first
+// instance's second call gives (the integral, the previous PV), through the
+// registry's save_state/load_state; a state of another size is refused.
+TEST(ControllerLibrary, SavedStateContinuesExactlyAndAWrongStateIsRefused) {
+  using namespace domel::platform;
+  PluginRegistry registry;
+  registry.load(std::string(DOMEL_BINARY_DIR) + "/plugins/libdomel_controller_std.so");
+  const RegisteredModel* m = registry.find(DOMEL_KIND_CONTROLLER, "stress_pi");
+  ASSERT_NE(m, nullptr);
+  json p = StressCase::params();
+  p["kd"] = StressCase::kT;  // the second call reads the previous PV too
+  ModelInstance a(*m, p, "a"), b(*m, p, "b");
+  ASSERT_TRUE(a.has_state());
+  StressCase c1, c2;
+  a.control(c1.L.step(StressCase::kT));
+  b.load_state(a.save_state());
+  c1.L.fine.grid.stress[6 * 2 + 2] = c2.L.fine.grid.stress[6 * 2 + 2] = -2000.0 / 3.0;
+  c1.L.fine.p.fz[c1.p0] = c2.L.fine.p.fz[c2.p0] = 0.0;
+  a.control(c1.L.step(StressCase::kT));
+  b.control(c2.L.step(StressCase::kT));
+  EXPECT_EQ(c1.L.fine.p.fz[c1.p0], c2.L.fine.p.fz[c2.p0]);
+  EXPECT_NE(c2.L.fine.p.fz[c2.p0], 0.0);
+  EXPECT_EQ(a.save_state(), b.save_state());
+
+  std::vector<unsigned char> state = a.save_state();
+  state.pop_back();
+  try {
+    b.load_state(state);
+    ADD_FAILURE() << "a truncated state was accepted";
+  } catch (const PluginError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+  }
+  state = a.save_state();
+  state.push_back(0);
+  try {
+    b.load_state(state);
+    ADD_FAILURE() << "a state with bytes left over was accepted";
+  } catch (const PluginError& e) {
+    EXPECT_NE(std::string(e.what()).find("bytes more"), std::string::npos) << e.what();
+  }
+  ModelInstance v(*registry.find(DOMEL_KIND_CONTROLLER, "velocity_p"), VelocityCase::params(), "v");
+  try {
+    v.load_state(a.save_state());
+    ADD_FAILURE() << "a stress_pi state was accepted by velocity_p";
+  } catch (const PluginError& e) {
+    EXPECT_NE(std::string(e.what()).find("load_state failed"), std::string::npos) << e.what();
+  }
+}

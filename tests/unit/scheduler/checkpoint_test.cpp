@@ -139,6 +139,31 @@ json heap() {
   return d;
 }
 
+json coupled_silo() {
+  // silo_ci_2lvl (alpha 2 over alpha 1 at the outlet, both controllers,
+  // match_outflow) with a smaller pour, the outlet opened at 0.1 s
+  json d = read_json("scenarios/silo/silo_ci_2lvl.json");
+  d["walls"][0]["outlet_open_at"] = 0.1;
+  d["subdomains"][0]["pour"][0]["total_mass"] = 0.08;
+  d["deletion_regions"][0]["rate_window"] = {0.12, 0.2};
+  d["output"]["mass_flow"][0]["rate_window"] = {0.12, 0.2};
+  d["run"]["duration"] = 0.2;
+  d["output"]["vtk_interval"] = 0.04;
+  d["output"]["probe_interval"] = 0.004;
+  return d;
+}
+
+json water_bed(const std::string& backend) {
+  // the alpha = 2 bed fluidised by water (hypre PFMG or Eigen CG pressure
+  // solve), its fields written every 0.01 s
+  json d = read_json("scenarios/fluid/bed/w2.json");
+  d["run"]["duration"] = 0.05;
+  d["output"]["vtk_interval"] = 0.01;
+  d["fluid"]["write_interval"] = 0.01;
+  d["fluid"]["solver"] = {{"backend", backend}};
+  return d;
+}
+
 TEST(Checkpoint, SettleRestartedIsBitIdentical) {
   for (int threads : {1, 2}) expect_restart_identical(settle(), "settle", 2345, 0.007, threads);
 }
@@ -155,6 +180,30 @@ TEST(Checkpoint, SiloWithPourDeletionPlaneAndOutletRestartedIsBitIdentical) {
 TEST(Checkpoint, SdCriticalAngleHeapRestartedIsBitIdentical) {
   // stopped after the cylinder was removed (step 1000), with rolling history live
   for (int threads : {1, 2}) expect_restart_identical(heap(), "heap", 1777, 0.01, threads);
+}
+
+TEST(Checkpoint, CoupledSiloRestartedIsBitIdentical) {
+  // stopped between two control intervals (every 8 macro steps) while fine
+  // particles are inserted at the +z face, controlled, and leave the region
+  // at -z through the open outlet; the coupling's balance and grid files
+  // (zone1_*) are among the files compared
+  for (int threads : {1, 2}) {
+    const json stopped = expect_restart_identical(coupled_silo(), "coupled", 5003, 0.05, threads);
+    const json& c = stopped["couplings"]["zone1"];
+    EXPECT_GT(c["transfers"].get<int>(), 0);
+    EXPECT_GT(c["faces"]["-z"]["removed"].get<int>(), 0) << "the fine level discharges before the stop";
+  }
+}
+
+TEST(Checkpoint, FluidisedBedRestartedIsBitIdentical) {
+  // stopped between two fluid exchanges (every 10 macro steps): the fluid's
+  // fields, the pressure solve's warm start and the particles' drag
+  // arrays all continue; fluid_*.vti and fluid.pvd are compared too
+  for (int threads : {1, 2}) {
+    const json stopped = expect_restart_identical(water_bed("pfmg"), "bed", 3001, 0.02, threads);
+    EXPECT_GT(stopped["fluid"]["exchanges"].get<int>(), 300);
+  }
+  expect_restart_identical(water_bed("cg"), "bed_cg", 2503, 0.02, 1);
 }
 
 TEST(Checkpoint, AnotherThreadCountRestartsWithAWarningAndTheSameBooks) {

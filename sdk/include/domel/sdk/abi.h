@@ -41,7 +41,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 2
-#define DOMEL_ABI_MINOR 2
+#define DOMEL_ABI_MINOR 3
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -223,6 +223,11 @@ typedef struct domel_insert_request_v1 {
   double length_scale;        /**< coarse-grain ratio alpha: radii are multiplied by it */
   size_t n_existing;          /**< particles already present, to be avoided */
   const double *ex_x, *ex_y, *ex_z, *ex_r;
+  /* ABI 2.3 */
+  size_t max_count;           /**< the most particles the host accepts from this call (the scenario's
+                                   run.max_particles); 0: no limit. A model that would place more refuses
+                                   before it allocates them: a region or a diameter in the wrong unit
+                                   otherwise fills the memory (domel::sdk::Inserted does it) */
 } domel_insert_request_v1;
 
 typedef struct domel_insert_output_v1 {
@@ -299,6 +304,33 @@ typedef struct domel_level_v1 {
 /* Controller family                                                          */
 /* ------------------------------------------------------------------------ */
 
+/** Where a model writes its state for a checkpoint (ABI 2.3): the host's
+ *  sink. write() appends n bytes to the model's state and may be called any
+ *  number of times; it returns DOMEL_OK, or an error status the model passes
+ *  back. The bytes are the model's own format: the host stores them as they
+ *  are, with the model's name and version, and hands them back to
+ *  load_state of an instance created with the same parameters. */
+typedef struct domel_state_sink_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  void* host;                 /**< the host's, passed back to write */
+  domel_status (*write)(void* host, const void* data, size_t n);
+} domel_state_sink_v1;
+
+/* A model that keeps state between calls (an integral term, a fluid field)
+ * provides both, so that a run stopped at a checkpoint and restarted goes on
+ * exactly as the uninterrupted run (docs/checkpoint.md). save_state writes
+ * everything the model's next call depends on; load_state, called on a
+ * fresh instance before its first call, restores it or refuses (a wrong
+ * size, a version it cannot read) with a message. A model without them
+ * cannot be checkpointed: the host refuses run.checkpoint_interval and
+ * --restart for a scenario that uses it, naming the model. A model without
+ * state provides both too, saving nothing. */
+typedef domel_status (*domel_save_state_fn)(void* instance, const domel_state_sink_v1* sink, char* err,
+                                            size_t err_capacity);
+typedef domel_status (*domel_load_state_fn)(void* instance, const void* data, size_t n, char* err,
+                                            size_t err_capacity);
+
 /** One control interval of a coupling between levels. levels[0] is the
  *  level the coupling is declared on (e.g. the fine one), levels[1] its
  *  partner (e.g. the coarse one); level_count is 2 for a coupling of two
@@ -321,6 +353,9 @@ typedef struct domel_controller_family_v1 {
   uint32_t struct_size;
   uint32_t reserved;          /**< 0 */
   domel_control_fn control;   /**< required */
+  /* ABI 2.3; optional: NULL, or beyond struct_size, means not provided */
+  domel_save_state_fn save_state; /**< its state for a checkpoint (with load_state) */
+  domel_load_state_fn load_state;
 } domel_controller_family_v1;
 
 /* ------------------------------------------------------------------------ */
@@ -420,6 +455,9 @@ typedef struct domel_fluid_coupler_family_v1 {
   /* ABI 2.2; optional: NULL, or beyond struct_size, means not provided */
   domel_fluid_fields_fn fields;     /**< the coupler's fields, for output */
   domel_fluid_limits_fn limits;     /**< its stability limit, checked after every exchange */
+  /* ABI 2.3; optional */
+  domel_save_state_fn save_state;   /**< its state (fields, solver warm start) for a checkpoint */
+  domel_load_state_fn load_state;
 } domel_fluid_coupler_family_v1;
 
 /* ------------------------------------------------------------------------ */

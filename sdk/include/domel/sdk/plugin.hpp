@@ -25,6 +25,9 @@
 //   fluid_coupler   void exchange(domel_fluid_exchange_v1&);
 //                   optional: void fields(domel_fluid_fields_v1&);
 //                             void limits(domel_fluid_limits_v1&);
+//   controller and fluid_coupler, for checkpoints (ABI 2.3), both or neither:
+//                   void save_state(domel::sdk::StateWriter&) const;
+//                   void load_state(domel::sdk::StateReader&);
 //
 // Host services: `p.host()` in the constructor is the model's domel::sdk::Host
 // (keep a copy); host.info("...") logs under the model's name and scenario
@@ -39,7 +42,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <stdexcept>
@@ -117,12 +122,96 @@ class Params {
 };
 
 /// Particles produced by an insertion model (radii already include alpha).
+/// A model's state for a checkpoint (abi.h, domel_state_sink_v1): values
+/// and arrays of trivially copyable types, in the order the model chooses.
+/// Host and plugin run on one machine, so the bytes are native.
+class StateWriter {
+ public:
+  template <class T>
+  void put(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>, "StateWriter::put takes trivially copyable values");
+    const auto* p = reinterpret_cast<const unsigned char*>(&value);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  /// An array: its length, then its elements.
+  template <class T>
+  void put(const std::vector<T>& values) {
+    static_assert(std::is_trivially_copyable_v<T>, "StateWriter::put takes arrays of trivially copyable values");
+    put<std::uint64_t>(values.size());
+    const auto* p = reinterpret_cast<const unsigned char*>(values.data());
+    bytes_.insert(bytes_.end(), p, p + values.size() * sizeof(T));
+  }
+  const std::vector<unsigned char>& bytes() const { return bytes_; }
+
+ private:
+  std::vector<unsigned char> bytes_;
+};
+
+/// Reads what a StateWriter wrote, in the same order; a read beyond the end,
+/// or bytes left over at the end, throws std::runtime_error (the host then
+/// refuses the checkpoint naming the model).
+class StateReader {
+ public:
+  StateReader(const void* data, std::size_t n) : p_(static_cast<const unsigned char*>(data)), n_(n) {}
+  template <class T>
+  T get() {
+    static_assert(std::is_trivially_copyable_v<T>, "StateReader::get reads trivially copyable values");
+    T value;
+    take(&value, sizeof(T));
+    return value;
+  }
+  /// An array written by StateWriter::put(vector); `expected` (if not
+  /// SIZE_MAX) is the length the model's parameters imply.
+  template <class T>
+  std::vector<T> get_vector(std::size_t expected = static_cast<std::size_t>(-1)) {
+    const auto n = get<std::uint64_t>();
+    if (expected != static_cast<std::size_t>(-1) && n != expected)
+      throw std::runtime_error("the saved state holds an array of " + std::to_string(n) + " values where " +
+                               std::to_string(expected) + " were expected (another grid or parameter set?)");
+    if (n > (n_ - at_) / (sizeof(T) ? sizeof(T) : 1))
+      throw std::runtime_error("the saved state is truncated (an array of " + std::to_string(n) + " values)");
+    std::vector<T> out(static_cast<std::size_t>(n));
+    take(out.data(), out.size() * sizeof(T));
+    return out;
+  }
+  /// Throws if bytes are left: the state was written by another layout.
+  void finish() const {
+    if (at_ != n_)
+      throw std::runtime_error("the saved state has " + std::to_string(n_ - at_) + " bytes more than this model reads");
+  }
+
+ private:
+  void take(void* out, std::size_t k) {
+    if (k > n_ - at_) throw std::runtime_error("the saved state is truncated");
+    if (k) std::memcpy(out, p_ + at_, k);
+    at_ += k;
+  }
+  const unsigned char* p_;
+  std::size_t n_;
+  std::size_t at_ = 0;
+};
+
 struct Inserted {
   std::vector<double> x, y, z, r;
+  /// The most particles the host accepts (the request's max_count; 0: no
+  /// limit): push() beyond it, or expect() of more, throws.
+  std::size_t limit = 0;
   void push(double px, double py, double pz, double pr) {
+    if (limit != 0 && r.size() >= limit) too_many("more than " + std::to_string(limit));
     x.push_back(px); y.push_back(py); z.push_back(pz); r.push_back(pr);
   }
+  /// Call before allocating for `n` particles: throws when n exceeds the limit.
+  void expect(double n) const {
+    if (limit != 0 && n > static_cast<double>(limit)) too_many("about " + std::to_string(static_cast<unsigned long long>(std::min(n, 1e19))));
+  }
   std::size_t size() const { return r.size(); }
+
+ private:
+  [[noreturn]] void too_many(const std::string& count) const {
+    throw std::runtime_error("the insertion would place " + count + " particles, more than the " +
+                             std::to_string(limit) + " the run accepts (run.max_particles): check the units of "
+                             "the region and of the diameters, or raise run.max_particles");
+  }
 };
 
 namespace detail {
@@ -159,6 +248,15 @@ template <class M, class = void>
 struct has_limits : std::false_type {};
 template <class M>
 struct has_limits<M, std::void_t<decltype(std::declval<M&>().limits(std::declval<domel_fluid_limits_v1&>()))>>
+    : std::true_type {};
+
+/// A controller or fluid coupler may keep state for checkpoints (ABI 2.3):
+/// `void save_state(StateWriter&) const` and `void load_state(StateReader&)`.
+template <class M, class = void>
+struct has_state : std::false_type {};
+template <class M>
+struct has_state<M, std::void_t<decltype(std::declval<const M&>().save_state(std::declval<StateWriter&>())),
+                                decltype(std::declval<M&>().load_state(std::declval<StateReader&>()))>>
     : std::true_type {};
 
 constexpr bool is_contact_kind(domel_kind k) {
@@ -265,6 +363,8 @@ struct Export {
         auto* inst = static_cast<Instance<M>*>(self);
         if (inst->last.size() == 0 || out->count != inst->last.size()) {
           inst->last = Inserted{};
+          if (req->struct_size >= offsetof(domel_insert_request_v1, max_count) + sizeof(req->max_count))
+            inst->last.limit = req->max_count;
           inst->model.insert(*req, inst->last);
         }
         const std::size_t n = inst->last.size();
@@ -336,6 +436,36 @@ struct Export {
     }
   }
 
+  static domel_status save_state(void* self, const domel_state_sink_v1* sink, char* err, std::size_t cap) {
+    if constexpr (has_state<M>::value) {
+      return guarded(err, cap, "save_state", [&] {
+        StateWriter w;
+        static_cast<const Instance<M>*>(self)->model.save_state(w);
+        if (sink == nullptr || sink->write == nullptr) throw std::runtime_error("no state sink");
+        return sink->write(sink->host, w.bytes().data(), w.bytes().size());
+      });
+    } else {
+      (void)self; (void)sink;
+      write_message(err, cap, "no state");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
+  static domel_status load_state(void* self, const void* data, std::size_t n, char* err, std::size_t cap) {
+    if constexpr (has_state<M>::value) {
+      return guarded(err, cap, "load_state", [&] {
+        StateReader r(data, n);
+        static_cast<Instance<M>*>(self)->model.load_state(r);
+        r.finish();
+        return DOMEL_OK;
+      });
+    } else {
+      (void)self; (void)data; (void)n;
+      write_message(err, cap, "no state");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
   /// The family table of M's kind.
   static const void* family() {
     if constexpr (is_contact_kind(M::kKind)) {
@@ -347,13 +477,16 @@ struct Export {
       static const domel_insertion_family_v2 t = {sizeof(domel_insertion_family_v2), 0u, &Export::insert};
       return &t;
     } else if constexpr (M::kKind == DOMEL_KIND_CONTROLLER) {
-      static const domel_controller_family_v1 t = {sizeof(domel_controller_family_v1), 0u, &Export::control};
+      static const domel_controller_family_v1 t = {sizeof(domel_controller_family_v1), 0u, &Export::control,
+                                                   has_state<M>::value ? &Export::save_state : nullptr,
+                                                   has_state<M>::value ? &Export::load_state : nullptr};
       return &t;
     } else {
       static_assert(M::kKind == DOMEL_KIND_FLUID_COUPLER, "a model's kKind must be a domel_kind");
       static const domel_fluid_coupler_family_v1 t = {
           sizeof(domel_fluid_coupler_family_v1), 0u, &Export::exchange,
-          has_fields<M>::value ? &Export::fields : nullptr, has_limits<M>::value ? &Export::limits : nullptr};
+          has_fields<M>::value ? &Export::fields : nullptr, has_limits<M>::value ? &Export::limits : nullptr,
+          has_state<M>::value ? &Export::save_state : nullptr, has_state<M>::value ? &Export::load_state : nullptr};
       return &t;
     }
   }
