@@ -61,6 +61,10 @@ CellGrid::CellGrid(CellGridSpec spec) : spec_(std::move(spec)) {
     inv_h_[a] = 1.0 / h_[a];
     n_cells_ *= static_cast<std::size_t>(spec_.cells[a]);
   }
+  if (n_cells_ > kMaxGridCells) {
+    throw std::invalid_argument(where + "has " + std::to_string(n_cells_) + " cells, more than the " +
+                                std::to_string(kMaxGridCells) + " a grid may have; use fewer, larger cells");
+  }
   if (spec_.every < 1) {
     throw std::invalid_argument(where + "every must be at least 1, got " + std::to_string(spec_.every));
   }

@@ -22,6 +22,11 @@
 
 namespace domel::platform {
 
+/// The most cells a grid may have (about 3 GB of averages): more is refused
+/// by the grid and by the scenario's checks, before anything is allocated.
+inline constexpr std::size_t kMaxGridCells = 10000000;
+
+
 class ArchiveWriter;
 class ArchiveReader;
 

@@ -89,6 +89,7 @@ void build_run(Build& b) {
   b.sim.threads = run.contains("threads") ? run["threads"].get<int>() : 0;
   b.sim.checkpoint_interval = run["checkpoint_interval"].get<double>();
   b.sim.flow.max_particles = run["max_particles"].get<std::size_t>();
+  if (particle_ceiling() != 0) b.sim.flow.max_particles = std::min(b.sim.flow.max_particles, particle_ceiling());
   b.sim.document = b.doc;
 }
 
@@ -658,6 +659,7 @@ void build_couplings(Build& b) {
     const double d_coarse = 2 * b.radii.at(names[s.coarse])[1];
     s.grid.name = s.name;
     bool box = true;
+    bool cells_ok = true;
     for (int a = 0; a < 3; ++a) {
       s.grid.lo[a] = rj["min"][a].get<double>();
       s.grid.hi[a] = rj["max"][a].get<double>();
@@ -670,15 +672,24 @@ void build_couplings(Build& b) {
         continue;
       }
       const double edge = (s.grid.hi[a] - s.grid.lo[a]) / s.grid.cells[a];
-      if (edge < 2 * d_coarse * (1 - 1e-9))
+      if (edge < 2 * d_coarse * (1 - 1e-9)) {
+        cells_ok = false;
         b.ck.add(base + "/region/cells/" + std::to_string(a),
                  "expected cells of at least 2 coarse parcel diameters (" + fmt_num(2 * d_coarse) + " m) along " +
                      std::string(1, "xyz"[a]) + ", found " + fmt_num(edge) + " m",
                  "use at most " + std::to_string(std::max(1, static_cast<int>((s.grid.hi[a] - s.grid.lo[a]) /
                                                                                (2 * d_coarse)))) +
                      " cells along " + std::string(1, "xyz"[a]));
+      }
     }
-    if (!box) continue;
+    if (!box || !cells_ok) continue;
+    const double n_region_cells = static_cast<double>(s.grid.cells[0]) * s.grid.cells[1] * s.grid.cells[2];
+    if (n_region_cells > static_cast<double>(kMaxGridCells)) {
+      b.ck.add(base + "/region/cells", "the region has " + fmt_num(n_region_cells) + " cells, more than the " +
+                                           std::to_string(kMaxGridCells) + " a grid may have",
+               "use fewer, larger cells");
+      continue;
+    }
     // inside the coarse level's domain
     if (auto it = b.parent.find(names[s.coarse]); it != b.parent.end()) {
       const json& pr = cs[it->second.second]["region"];

@@ -13,6 +13,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -564,6 +565,13 @@ json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& 
 }
 
 }  // namespace
+
+namespace {
+std::atomic<std::size_t> g_particle_ceiling{0};
+}  // namespace
+
+void set_particle_ceiling(std::size_t n) { g_particle_ceiling = n; }
+std::size_t particle_ceiling() { return g_particle_ceiling; }
 
 std::vector<Diagnostic> validate_scenario_file(const std::filesystem::path& file, PluginRegistry& registry) {
   std::vector<Diagnostic> diags;

@@ -36,6 +36,13 @@ nlohmann::json composed_scenario_schema(const PluginRegistry& registry);
 /// parameter schema plus the platform-owned keys of that block.
 nlohmann::json model_block_schema(const RegisteredModel& model);
 
+/// A ceiling on run.max_particles for every scenario this process builds
+/// (0, the default: none). The fuzz harness (tests/fuzz/scenario_fuzz.cpp)
+/// sets one so that an input asking for millions of particles is refused
+/// within its time and memory budget, as a larger one is in a normal run.
+void set_particle_ceiling(std::size_t n);
+std::size_t particle_ceiling();
+
 /// Load plugins the scenario names, and validate. Returns all problems (empty if valid).
 std::vector<Diagnostic> validate_scenario_file(const std::filesystem::path& file, PluginRegistry& registry);
 

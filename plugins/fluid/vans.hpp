@@ -49,6 +49,7 @@ class Vans {
   static constexpr domel_kind kKind = DOMEL_KIND_FLUID_COUPLER;
   static constexpr const char* kName = "vans";
   static constexpr const char* kVersion = "0.2.0";
+  static constexpr double kMaxCells = 1e7;
   static constexpr const char* kSummary =
       "volume-averaged Navier-Stokes (model A) on a uniform staggered grid, semi-implicit drag, two-way";
   static constexpr const char* kSchema = R"json({
@@ -125,6 +126,12 @@ class Vans {
       s.grid.n[d] = n;
       s.grid.h[d] = (hi - lo) / n;
     }
+    // the solver keeps some 20 arrays per cell: more than 10^7 cells is a
+    // grid in the wrong unit far more often than a run that fits in memory
+    const double cells = static_cast<double>(s.grid.n[0]) * s.grid.n[1] * s.grid.n[2];
+    if (cells > kMaxCells)
+      throw sdk::ParameterError("grid: " + std::to_string(static_cast<long long>(cells)) + " cells, more than the " +
+                                std::to_string(static_cast<long long>(kMaxCells)) + " this coupler accepts; use fewer, larger cells");
     s.rho = p.number("density");
     s.mu = p.number("viscosity");
     if (j.contains("initial_velocity"))
