@@ -97,12 +97,20 @@ def main():
     with open(log, "w") as f:
         rc = subprocess.call(cmd, stdout=f, stderr=subprocess.STDOUT, env=env, cwd=args.work)
     # with --jobs, each job writes its own fuzz-<n>.log in the working folder
-    text = "".join(open(f, errors="replace").read()
-                   for f in [log] + sorted(glob.glob(os.path.join(args.work, "fuzz-*.log"))))
-    execs = [int(x) for x in re.findall(r"stat::number_of_executed_units:\s+(\d+)", text)]
+    # each log prints its final stats more than once: count the largest per log
+    execs, corp = [], []
+    # (the main log repeats the jobs' logs when there are jobs: read it only without)
+    for f in sorted(glob.glob(os.path.join(args.work, "fuzz-*.log"))) or [log]:
+        text = open(f, errors="replace").read()
+        n = [int(x) for x in re.findall(r"stat::number_of_executed_units:\s+(\d+)", text)]
+        execs.append(max(n) if n else 0)
+        c = re.findall(r"cov: (\d+) ft: \d+ corp: (\d+)/", text)
+        if c:
+            corp.append("cov %s, corpus %s" % c[-1])
     found = sorted(os.listdir(artefacts))
-    print("exit code %d; executions %d; seeds %d; corpus now %d files; findings: %s" %
-          (rc, sum(execs), seeds, len(os.listdir(corpus)), ", ".join(found) if found else "none"))
+    print("exit code %d; executions %d; seeds %d; corpus folder now %d files; last status per job: %s; findings: %s" %
+          (rc, sum(execs), seeds, len(os.listdir(corpus)), "; ".join(corp) or "none",
+           ", ".join(found) if found else "none"))
     return 0 if rc == 0 and not found else 1
 
 
