@@ -5,6 +5,8 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "loader/plugin_registry.hpp"
+#include "coupling/coupling.hpp"
+#include "fluid/fluid_coupling.hpp"
 #include "scheduler/simulation.hpp"
 
 #include <ctime>
@@ -51,6 +53,22 @@ int major_of(const std::string& version) {
   }
 }
 
+/// The models that keep their own state in the checkpoint (ABI 2.3): each
+/// coupling's controllers and the fluid coupler, "where" -> {model, version, library}.
+nlohmann::json stateful_models(const Simulation& sim) {
+  nlohmann::json j = nlohmann::json::object();
+  auto entry = [](const ModelInstance& m) {
+    return nlohmann::json{{"model", m.model().name}, {"version", m.model().version}, {"library", m.model().library_name}};
+  };
+  for (const auto& c : sim.couplings) {
+    if (c->spec().stress.enabled) j["coupling '" + c->spec().name + "', stress_control"] = entry(*c->spec().stress.model);
+    if (c->spec().velocity.enabled)
+      j["coupling '" + c->spec().name + "', velocity_control"] = entry(*c->spec().velocity.model);
+  }
+  if (sim.fluid) j["fluid"] = entry(*sim.fluid->spec().model);
+  return j;
+}
+
 }  // namespace
 
 void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
@@ -76,6 +94,7 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
                    {"steps", sd->steps()}, {"time_step_s", sd->time_step()}});
   header["subdomains"] = sds;
   header["models"] = sim.models_used;
+  header["stateful_models"] = stateful_models(sim);
   nlohmann::json libs = nlohmann::json::array();
   for (const auto& lib : registry.libraries())
     libs.push_back({{"name", lib.name}, {"version", lib.version},
@@ -145,6 +164,22 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
       else if (old_v != new_v)
         ck.allowed_changes.push_back("subdomain '" + sd + "', " + slot + " model version " + old_v + " -> " + new_v);
     }
+  }
+  // The controllers and the fluid coupler: their saved state is their own
+  // format, so another major version is refused too.
+  const nlohmann::json was_stateful = ck.header.value("stateful_models", nlohmann::json::object());
+  const nlohmann::json now_stateful = stateful_models(sim);
+  for (const auto& [where, m] : now_stateful.items()) {
+    if (!was_stateful.contains(where)) continue;  // a scenario change, reported above
+    const std::string old_v = was_stateful[where].value("version", std::string()), new_v = m.value("version", std::string());
+    if (major_of(old_v) != major_of(new_v))
+      refused.push_back(Diagnostic{sim.scenario_file.string(), "",
+                                   where + " model '" + m.value("model", std::string()) +
+                                       "': the checkpoint was written with version " + old_v + ", this run loads " +
+                                       new_v + " (another major version may save its state differently)",
+                                   ""});
+    else if (old_v != new_v)
+      ck.allowed_changes.push_back(where + " model version " + old_v + " -> " + new_v);
   }
   if (!refused.empty()) throw ConfigError(refused);
 
