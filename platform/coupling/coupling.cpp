@@ -44,6 +44,11 @@ int face_beyond(const CellGridSpec& g, double x, double y, double z) {
   return face;
 }
 
+/// A coupling's two controllers, with the checkpoint section of each one's state.
+std::array<std::pair<const ControllerSetup*, const char*>, 2> controllers_of(const CouplingSpec& s) {
+  return {{{&s.stress, "stress_state"}, {&s.velocity, "velocity_state"}}};
+}
+
 /// Consecutive transfers with a growing backlog before the warning.
 constexpr int kBacklogWarnAfter = 5;
 
@@ -577,10 +582,10 @@ void Coupling::save(ArchiveWriter& w, const std::string& p) {
   w.put_scalar<std::uint64_t>(p + "balance_bytes", balance_bytes);
   w.put(p + "vtk_fine_times", vtk_fine_ ? vtk_fine_->frame_times() : std::vector<double>{});
   w.put(p + "vtk_coarse_times", vtk_coarse_ ? vtk_coarse_->frame_times() : std::vector<double>{});
-  for (const auto* c : {&spec_.stress, &spec_.velocity})
+  for (const auto& [c, key] : controllers_of(spec_))
     if (c->enabled) {
       const auto bytes = c->model->save_state();
-      w.put_text(p + (c == &spec_.stress ? "stress_state" : "velocity_state"), std::string(bytes.begin(), bytes.end()));
+      w.put_text(p + key, std::string(bytes.begin(), bytes.end()));
     }
 }
 
@@ -629,14 +634,13 @@ void Coupling::load(const ArchiveReader& r, const std::string& p) {
   if (balance_ && balance_bytes > 0) balance_->resume(balance_bytes);
   if (vtk_fine_) vtk_fine_->resume(r.get<double>(p + "vtk_fine_times"));
   if (vtk_coarse_) vtk_coarse_->resume(r.get<double>(p + "vtk_coarse_times"));
-  for (const auto* c : {&spec_.stress, &spec_.velocity}) {
+  for (const auto& [c, key] : controllers_of(spec_)) {
     if (!c->enabled) continue;
-    const std::string key = p + (c == &spec_.stress ? "stress_state" : "velocity_state");
-    const std::string bytes = r.text(key);
+    const std::string bytes = r.text(p + key);
     try {
       c->model->load_state(std::vector<unsigned char>(bytes.begin(), bytes.end()));
     } catch (const PluginError& e) {
-      r.fail(key, std::string("holds a state the controller refuses: ") + e.what());
+      r.fail(p + key, std::string("holds a state the controller refuses: ") + e.what());
     }
   }
 }
