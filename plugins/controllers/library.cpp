@@ -6,6 +6,6 @@
 #include "stress_pi.hpp"
 #include "velocity_p.hpp"
 
-DOMEL_PLUGIN_LIBRARY("domel_controller_std", "1.0.0",
+DOMEL_PLUGIN_LIBRARY("domel_controller_std", "1.1.0",
                      domel::plugins::controller::StressPi,   // controller: fine <- coarse, stress PI
                      domel::plugins::controller::VelocityP)  // controller: coarse <- fine, velocity P(I)

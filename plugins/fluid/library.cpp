@@ -4,4 +4,4 @@
 // the header-only Eigen for its pressure solve).
 #include "plugins/fluid/vans.hpp"
 
-DOMEL_PLUGIN_LIBRARY("domel_fluid_std", "0.1.0", domel::plugins::fluid::Vans)
+DOMEL_PLUGIN_LIBRARY("domel_fluid_std", "0.2.0", domel::plugins::fluid::Vans)
