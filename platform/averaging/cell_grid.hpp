@@ -38,6 +38,7 @@ struct ContactRecord {
   std::uint32_t j;        ///< partner particle index, or kWall
   double fx, fy, fz;      ///< force on i [N] (j receives the opposite)
   double px, py, pz;      ///< wall contacts: the contact point [m]; unused for pairs
+  std::uint32_t wall = 0; ///< wall contacts: the subdomain's wall primitive; unused for pairs
   static constexpr std::uint32_t kWall = 0xffffffffu;
 };
 

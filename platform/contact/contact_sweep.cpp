@@ -289,7 +289,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
         if (sw.record)  // the contact point lies on the wall, ci from the centre along -n
           ts.records.push_back({i, ContactRecord::kWall, l.fx, l.fy, l.fz, s.x[i] - ci * nx, s.y[i] - ci * ny,
-                                s.z[i] - ci * nz});
+                                s.z[i] - ci * nz, static_cast<uint32_t>(w)});
       }
       contacts += c;
       c = 0;

@@ -33,6 +33,7 @@ struct WallPrimitive {
   enum class Shape { plane, cylinder_inside, cone_inside, annulus, mesh };
   Shape shape = Shape::plane;
   std::string name;          ///< e.g. "container.zmin"
+  std::size_t wall = 0;      ///< index of the scenario wall it belongs to (output.wall_loads, walls.pvd)
   std::size_t material = 0;  ///< index into the scenario's materials
   // plane: a point on it and the unit normal pointing to the particles' side
   // annulus: its centre and the unit normal pointing to the particles' side
@@ -53,6 +54,15 @@ struct WallPrimitive {
   std::shared_ptr<const TriangleMesh> mesh;
   std::vector<double> verts;
   std::vector<double> tri_bounds;  ///< enclosing sphere per triangle at `verts` (triangle_bounds())
+  // Drawing only (walls.pvd): how far an unbounded primitive is drawn. A
+  // plane with draw_in_box is the face of a box, drawn as its rectangle
+  // [draw_lo, draw_hi]; a plane or an annulus with draw_radius > 0 closes a
+  // container, drawn as a disk (a ring) out to that radius about p. Other
+  // planes are clipped to the scene's box, other annuli without an outer
+  // radius drawn out to the scene's reach.
+  double draw_radius = 0.0;
+  bool draw_in_box = false;
+  double draw_lo[3] = {0, 0, 0}, draw_hi[3] = {0, 0, 0};
   /// simulated time from which the wall is gone (an outlet plug, a lifted cylinder)
   double remove_at = std::numeric_limits<double>::infinity();
   /// simulated time from which the wall acts (an outlet that opens); contacts start with zero history

@@ -73,6 +73,8 @@ void VtkFrames::resume(const std::vector<double>& times) {
 
 fs::path VtkFrames::write(vtkXMLWriter& writer, double time) {
   std::error_code ec;
+  fs::create_directories(directory_, ec);
+  if (ec) throw RuntimeError("cannot create output directory '" + directory_.string() + "': " + ec.message());
   const std::string file = frame_name(frames_.size());
   const fs::path target = directory_ / file;
   record_output(target);

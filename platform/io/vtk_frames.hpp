@@ -20,7 +20,8 @@ class VtkFrames {
 
   /// Write the writer's input as the next frame at simulated `time` and
   /// rewrite <basename>.pvd. The writer's input must be set; its file name
-  /// and encoding are set here. Throws RuntimeError when a file cannot be
+  /// and encoding are set here; the directory is created (with parents) if
+  /// it does not exist. Throws RuntimeError when a file cannot be
   /// written. Returns the frame's path.
   std::filesystem::path write(vtkXMLWriter& writer, double time);
 

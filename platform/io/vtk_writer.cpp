@@ -44,7 +44,9 @@ void check_store(const ParticleSet& set) {
   const bool consistent = s.x.size() == n && s.y.size() == n && s.z.size() == n &&
                           s.vx.size() == n && s.vy.size() == n && s.vz.size() == n &&
                           s.wx.size() == n && s.wy.size() == n && s.wz.size() == n &&
-                          s.radius.size() == n && s.contacts.size() == n;
+                          s.fx.size() == n && s.fy.size() == n && s.fz.size() == n && s.tx.size() == n &&
+                          s.ty.size() == n && s.tz.size() == n && s.radius.size() == n && s.mass.size() == n &&
+                          s.contacts.size() == n;
   if (!consistent) {
     throw RuntimeError("VtkSeriesWriter::write: particle store of subdomain " +
                        std::to_string(set.subdomain) + " has arrays of different lengths");
@@ -82,15 +84,23 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
   points->SetNumberOfPoints(n);
   auto velocity = vector_array("velocity", n);
   auto angular_velocity = vector_array("angular_velocity", n);
+  auto force = vector_array("force", n);
+  auto torque = vector_array("torque", n);
   vtkNew<vtkDoubleArray> radius;
   radius->SetName("radius");
   radius->SetNumberOfTuples(n);
+  vtkNew<vtkDoubleArray> mass;
+  mass->SetName("mass");
+  mass->SetNumberOfTuples(n);
   vtkNew<vtkTypeUInt64Array> id;
   id->SetName("id");
   id->SetNumberOfTuples(n);
   vtkNew<vtkIntArray> subdomain;
   subdomain->SetName("subdomain");
   subdomain->SetNumberOfTuples(n);
+  vtkNew<vtkIntArray> material;
+  material->SetName("material");
+  material->SetNumberOfTuples(n);
   vtkNew<vtkIntArray> contacts;
   contacts->SetName("contacts");
   contacts->SetNumberOfTuples(n);
@@ -101,9 +111,13 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
   auto* pos = static_cast<double*>(points->GetData()->GetVoidPointer(0));
   double* vel = velocity->GetPointer(0);
   double* ang = angular_velocity->GetPointer(0);
+  double* frc = force->GetPointer(0);
+  double* trq = torque->GetPointer(0);
   double* rad = radius->GetPointer(0);
+  double* mas = mass->GetPointer(0);
   auto* ids = static_cast<std::uint64_t*>(id->GetVoidPointer(0));
   int* sub = subdomain->GetPointer(0);
+  int* mat = material->GetPointer(0);
   int* con = contacts->GetPointer(0);
   vtkIdType* conn = connectivity->GetPointer(0);
 
@@ -114,9 +128,13 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
       pos[3 * k] = s.x[i]; pos[3 * k + 1] = s.y[i]; pos[3 * k + 2] = s.z[i];
       vel[3 * k] = s.vx[i]; vel[3 * k + 1] = s.vy[i]; vel[3 * k + 2] = s.vz[i];
       ang[3 * k] = s.wx[i]; ang[3 * k + 1] = s.wy[i]; ang[3 * k + 2] = s.wz[i];
+      frc[3 * k] = s.fx[i]; frc[3 * k + 1] = s.fy[i]; frc[3 * k + 2] = s.fz[i];
+      trq[3 * k] = s.tx[i]; trq[3 * k + 1] = s.ty[i]; trq[3 * k + 2] = s.tz[i];
       rad[k] = s.radius[i];
+      mas[k] = s.mass[i];
       ids[k] = s.id[i];
       sub[k] = set.subdomain;
+      mat[k] = set.material;
       // Int32 is what ParaView filters handle best; a count never gets near INT_MAX.
       con[k] = static_cast<int>(std::min<std::uint32_t>(s.contacts[i], INT_MAX));
       conn[k] = static_cast<vtkIdType>(k);
@@ -132,17 +150,14 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
   vtkPointData* pd = poly->GetPointData();
   pd->AddArray(velocity);
   pd->AddArray(angular_velocity);
+  pd->AddArray(force);
+  pd->AddArray(torque);
   pd->AddArray(radius);
+  pd->AddArray(mass);
   pd->AddArray(id);
   pd->AddArray(subdomain);
+  pd->AddArray(material);
   pd->AddArray(contacts);
-
-  std::error_code ec;
-  fs::create_directories(directory_, ec);
-  if (ec) {
-    throw RuntimeError("cannot create output directory '" + directory_.string() +
-                       "': " + ec.message());
-  }
 
   vtkNew<vtkXMLPolyDataWriter> writer;
   writer->SetInputData(poly);

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // ParaView output of the particles: one VTK XML PolyData file (.vtp) per
 // output time, holding every particle of every subdomain as a vertex with its
-// velocity, angular velocity, radius, id, subdomain and contact count, plus a
+// velocity, angular velocity, force, torque, radius, mass, id, subdomain,
+// material and contact count, plus a
 // .pvd collection file that lists the frames with their times so ParaView
 // opens the whole series as one time-dependent data set. Both files are
 // replaced atomically, so the series can be opened while the run goes on.
@@ -23,6 +24,7 @@ namespace domel::platform::io {
 struct ParticleSet {
   const ParticleStore* store;
   int subdomain;
+  int material = 0;  ///< index into the scenario's materials (one per subdomain)
 };
 
 /// ParaView particle time series: <dir>/<basename>_<000000>.vtp files plus
@@ -40,7 +42,9 @@ class VtkSeriesWriter {
 
   /// Writes one .vtp with all particles of all sets (in order) as vertices,
   /// point-data arrays "velocity" (3 comp, double), "angular_velocity" (3),
-  /// "radius" (double), "id" (UInt64), "subdomain" (Int32), "contacts" (Int32).
+  /// "force" (3, the total of the last force evaluation: body forces,
+  /// contacts, controllers, fluid), "torque" (3), "radius", "mass" (double),
+  /// "id" (UInt64), "subdomain", "material", "contacts" (Int32).
   /// Binary appended, zlib-compressed. The .vtp is written under a temporary
   /// name in the same directory then renamed; then the .pvd is rewritten
   /// atomically, listing every file written so far (relative names).

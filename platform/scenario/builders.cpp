@@ -68,9 +68,11 @@ void build_materials(Build& b) {
 
 void build_walls(Build& b) {
   if (!b.doc.contains("walls")) return;
-  for (const auto& w : b.doc["walls"]) {
+  for (std::size_t k = 0; k < b.doc["walls"].size(); ++k) {
+    const json& w = b.doc["walls"][k];
+    b.sim.wall_names.push_back(w["name"].get<std::string>());
     try {
-      auto prims = expand_wall(w, b.mat_index.at(w["material"].get<std::string>()), b.file);
+      auto prims = expand_wall(w, k, b.mat_index.at(w["material"].get<std::string>()), b.file);
       b.sim.walls.insert(b.sim.walls.end(), prims.begin(), prims.end());
     } catch (const MeshError& e) {  // the file changed since validation
       b.ck.add("/walls", e.what());
@@ -528,6 +530,79 @@ void build_particle_flow(Build& b) {
   flow.register_hooks(b.sim.hooks);
 }
 
+/// output.wall_loads (the probes and their torque axes) and output.contacts;
+/// the contact files' interval is resolved by build_outputs().
+void build_contact_outputs(Build& b) {
+  const json& out = b.doc["output"];
+  std::vector<WallLoadProbe> probes;
+  if (out.contains("wall_loads"))
+    for (std::size_t i = 0; i < out["wall_loads"].size(); ++i) {
+      const json& d = out["wall_loads"][i];
+      const std::string base = idx("/output/wall_loads", i);
+      const std::string want = d["wall"].get<std::string>();
+      const auto it = std::find(b.sim.wall_names.begin(), b.sim.wall_names.end(), want);
+      if (it == b.sim.wall_names.end()) {
+        b.ck.add(base + "/wall",
+                 b.sim.wall_names.empty() ? "unknown wall '" + want + "': the scenario has no walls"
+                                          : "unknown wall '" + want + "'",
+                 suggest(want, b.sim.wall_names));
+        continue;
+      }
+      WallLoadProbe p;
+      p.wall = static_cast<std::size_t>(it - b.sim.wall_names.begin());
+      p.name = d.contains("name") ? d["name"].get<std::string>() : want;
+      if (d.contains("subdomain")) p.subdomain = subdomain_index(b, d["subdomain"], base + "/subdomain");
+      const json& w = b.doc["walls"][p.wall];
+      const std::string type = w["type"].get<std::string>();
+      auto set_axis = [&p](const json& point, const double dir[3]) {
+        p.has_axis = true;
+        const double len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        for (int a = 0; a < 3; ++a) {
+          p.point[a] = point[a].get<double>();
+          p.axis[a] = dir[a] / len;
+        }
+      };
+      double dir[3] = {0, 0, 0};
+      if (const json* ax = member(d, "axis")) {
+        for (int a = 0; a < 3; ++a) dir[a] = (*ax)["direction"][a].get<double>();
+        if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) {
+          b.ck.add(base + "/axis/direction", "expected a non-zero direction, found [0, 0, 0]");
+          continue;
+        }
+        set_axis((*ax)["point"], dir);
+      } else if (const json* mo = member(w, "motion");
+                 mo && ((*mo)["angular_velocity"][0].get<double>() != 0 ||
+                        (*mo)["angular_velocity"][1].get<double>() != 0 ||
+                        (*mo)["angular_velocity"][2].get<double>() != 0)) {
+        // the rotation axis, through the motion's origin (the default origin as WallPrimitive has it)
+        const WallPrimitive& prim = *std::find_if(b.sim.walls.begin(), b.sim.walls.end(),
+                                                  [&](const WallPrimitive& q) { return q.wall == p.wall; });
+        for (int a = 0; a < 3; ++a) dir[a] = prim.omega[a];
+        const json origin = {prim.origin[0], prim.origin[1], prim.origin[2]};
+        set_axis(origin, dir);
+      } else if (type == "cylinder" || type == "cone") {
+        dir[axis_index(&w["axis"])] = 1.0;
+        set_axis(w["center"], dir);
+      } else if (type == "disk") {
+        for (int a = 0; a < 3; ++a) dir[a] = w["normal"][a].get<double>();
+        set_axis(w["center"], dir);
+      }
+      for (const auto& other : probes)
+        if (other.name == p.name)
+          b.ck.add(base + "/name", "duplicate wall_loads name '" + p.name + "': both would write " + p.name +
+                                       ".force_x to probes.csv",
+                   "give one of them a \"name\"");
+      probes.push_back(p);
+    }
+  if (out.contains("contacts") && !out["contacts"].contains("interval") && out.contains("vtk_interval") &&
+      out["vtk_interval"].get<double>() == 0)
+    b.ck.add("/output/contacts", "expected an interval, found none while output.vtk_interval is 0 (no particle "
+                                 "frames to follow)",
+             "give output.contacts.interval");
+  b.sim.contact_sample.configure(std::move(probes), out.contains("contacts"));
+  b.sim.wall_surfaces = out["wall_surfaces"].get<bool>();
+}
+
 /// The parent map of /couplings (fine -> coarse), read before the subdomains
 /// are built: a coupled fine level takes its particle size from its parent.
 void scan_couplings(Build& b) {
@@ -558,17 +633,26 @@ bool descends_from(const Build& b, const std::string& level, const std::string& 
   return false;
 }
 
+bool walls_and_regions_bounds(Build& b, double lo[3], double hi[3], bool all);
+
 /// Bounding box of a top-level domain: when the walls enclose a finite
 /// region (a cylinder, a cone or a mesh), their bounding box together with
 /// the pour, insertion and deletion regions (particles fall out of an outlet
 /// into a deletion region). False with planes alone: the domain is unbounded.
 bool domain_bounds(Build& b, double lo[3], double hi[3]) {
-  bool any = false;
   bool enclosed = false;
   for (const auto& w : b.sim.walls)
     enclosed = enclosed || w.shape == WallPrimitive::Shape::cylinder_inside ||
                w.shape == WallPrimitive::Shape::cone_inside || w.shape == WallPrimitive::Shape::mesh;
   if (!enclosed) return false;
+  return walls_and_regions_bounds(b, lo, hi, false);
+}
+
+/// The box of the enclosing walls (mantles, meshes) and of every region
+/// (deletion, pour, insertion); with `all`, also of every other finite wall
+/// (disks, a box's faces, a container's bottom) and a plane's point.
+bool walls_and_regions_bounds(Build& b, double lo[3], double hi[3], bool all) {
+  bool any = false;
   auto grow = [&](const double a[3], const double z[3]) {
     for (int k = 0; k < 3; ++k) {
       lo[k] = any ? std::min(lo[k], a[k]) : a[k];
@@ -599,6 +683,16 @@ bool domain_bounds(Build& b, double lo[3], double hi[3]) {
       for (std::size_t v = 0; v + 2 < w.verts.size(); v += 3)
         for (int k = 0; k < 3; ++k) a[k] = std::min(a[k], w.verts[v + k]), z[k] = std::max(z[k], w.verts[v + k]);
       grow(a, z);
+    } else if (all && w.shape == WallPrimitive::Shape::plane && w.draw_in_box) {
+      grow(w.draw_lo, w.draw_hi);
+    } else if (all) {  // a plane's point; a disk or a container's bottom as far as it is drawn
+      const double r = w.shape == WallPrimitive::Shape::annulus && std::isfinite(w.r_outer) ? w.r_outer
+                                                                                             : w.draw_radius;
+      for (int k = 0; k < 3; ++k) {
+        a[k] = w.p[k] - r;
+        z[k] = w.p[k] + r;
+      }
+      grow(a, z);
     }
   }
   if (b.doc.contains("deletion_regions"))
@@ -609,6 +703,35 @@ bool domain_bounds(Build& b, double lo[3], double hi[3]) {
       for (const auto& ins : sd["insert"])
         if (ins.contains("region")) grow_region(make_region(ins["region"]));
   return any;
+}
+
+/// The scene's box for drawing walls (output.wall_surfaces): the walls, the
+/// regions and the particles at the start, padded by 5 % of its diagonal (a
+/// plane alone: 1 m about its point).
+void scene_bounds(Build& b) {
+  Simulation& sim = b.sim;
+  double lo[3], hi[3];
+  bool any = walls_and_regions_bounds(b, lo, hi, true);
+  for (const auto& sd : sim.subdomains) {
+    const ParticleStore& s = sd->store();
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      const double x[3] = {s.x[k], s.y[k], s.z[k]};
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = any ? std::min(lo[a], x[a] - s.radius[k]) : x[a] - s.radius[k];
+        hi[a] = any ? std::max(hi[a], x[a] + s.radius[k]) : x[a] + s.radius[k];
+      }
+      any = true;
+    }
+  }
+  if (!any)
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = 0.0;
+  double diag = 0;
+  for (int a = 0; a < 3; ++a) diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+  const double pad = diag > 0 ? 0.05 * std::sqrt(diag) : 0.5;
+  for (int a = 0; a < 3; ++a) {
+    sim.scene_lo[a] = lo[a] - pad;
+    sim.scene_hi[a] = hi[a] + pad;
+  }
 }
 
 /// /couplings: levels, region and cells, faces, timing, controllers.
@@ -1092,6 +1215,10 @@ void build_outputs(Build& b) {
   sim.vtk_interval = out.contains("vtk_interval") ? out["vtk_interval"].get<double>() : sim.duration / 50.0;
   sim.probe_interval = out.contains("probe_interval") ? out["probe_interval"].get<double>() : sim.duration / 500.0;
   sim.write_state = out["state"].get<bool>();
+  if (out.contains("contacts"))
+    sim.contact_interval = out["contacts"].contains("interval") ? out["contacts"]["interval"].get<double>()
+                                                                : sim.vtk_interval;
+  scene_bounds(b);
   for (auto& g : sim.grid_setups)
     if (g.spec.write_interval < 0) g.spec.write_interval = sim.duration / 20.0;
 }
@@ -1111,6 +1238,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_particle_flow(b);
   build_grids(b);
   build_repose_probe(b);
+  build_contact_outputs(b);
   std::optional<FluidSpec> fluid = build_fluid(b);
   if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);
   build_outputs(b);

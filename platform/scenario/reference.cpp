@@ -198,6 +198,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
                              {"output", "Output (`output`)"},
                              {"mass_flow_plane", "Mass-flow plane (`output.mass_flow[]`)"},
                              {"region_mass", "Mass in a region (`output.region_mass[]`)"},
+                             {"wall_load", "Load on a wall (`output.wall_loads[]`)"},
                              {"cell_grid", "Cell grid (`output.grids[]`)"}};
   for (const auto& b : blocks) {
     const json& s = root["$defs"][b[0]];
@@ -222,7 +223,8 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       const char* prefix;
       std::vector<const char*> members;
     } nested[] = {{"coupling", "couplings[].", {"region", "stress_control", "velocity_control"}},
-                  {"output", "output.", {"repose_angle"}}};
+                  {"output", "output.", {"repose_angle", "contacts"}},
+                  {"wall_load", "output.wall_loads[].", {"axis"}}};
     for (const auto& n : nested) {
       if (std::string(b[0]) != n.block) continue;
       for (const char* sub : n.members) {

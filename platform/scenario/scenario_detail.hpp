@@ -94,7 +94,8 @@ domel_region_v1 make_region(const json& region);
 
 /// A wall block as its primitives, remove_at and motion applied (shapes.cpp).
 /// Throws MeshError when a mesh file cannot be read.
-std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material, const std::filesystem::path& scenario_file);
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t wall_index, std::size_t material,
+                                       const std::filesystem::path& scenario_file);
 
 /// Build a Simulation from a validated document whose schema defaults are
 /// filled in (builders.cpp); throws ConfigError with every problem found.

@@ -86,6 +86,11 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
       p[a] = (is_min ? w["min"] : w["max"])[a].get<double>();
       n[a] = is_min ? 1.0 : -1.0;
       plane(name + "." + faces[f], p, n);
+      out.back().draw_in_box = true;
+      for (int k = 0; k < 3; ++k) {
+        out.back().draw_lo[k] = w["min"][k].get<double>();
+        out.back().draw_hi[k] = w["max"][k].get<double>();
+      }
     }
   } else if (type == "cylinder") {
     WallPrimitive m = mantle(WallPrimitive::Shape::cylinder_inside);
@@ -120,6 +125,7 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
       p[m.axis] = m.hi; n[m.axis] = -1.0;
       plane(name + ".top", p, n);
     }
+    for (std::size_t k = 1; k < out.size(); ++k) out[k].draw_radius = m.radius;  // bottom, plug, top
   } else if (type == "cone") {
     WallPrimitive m = mantle(WallPrimitive::Shape::cone_inside);
     m.radius = w["radius_bottom"].get<double>();
@@ -177,8 +183,10 @@ std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material
 
 }  // namespace
 
-std::vector<WallPrimitive> expand_wall(const json& w, std::size_t material, const std::filesystem::path& scenario_file) {
+std::vector<WallPrimitive> expand_wall(const json& w, std::size_t wall_index, std::size_t material,
+                                       const std::filesystem::path& scenario_file) {
   std::vector<WallPrimitive> out = expand_wall_shape(w, material, scenario_file);
+  for (auto& p : out) p.wall = wall_index;
   if (w.contains("remove_at"))
     for (auto& p : out) p.remove_at = std::min(p.remove_at, w["remove_at"].get<double>());
   if (const json* mo = member(w, "motion")) {

@@ -12,7 +12,9 @@
 #include "io/csv_series.hpp"
 #include "io/output_folder.hpp"
 #include "io/particle_state.hpp"
+#include "io/contact_writer.hpp"
 #include "io/vtk_writer.hpp"
+#include "io/wall_surfaces.hpp"
 #include "scheduler/checkpoint.hpp"
 
 #include <spdlog/spdlog.h>
@@ -97,6 +99,8 @@ std::string probe_column_unit(const std::string& column) {
   if (name == "repose_angle_deg") return "deg";
   if (name == "mass_kg" || name == "removed_kg") return "kg";
   if (name == "rate_kg_s") return "kg/s";
+  if (name == "force_x" || name == "force_y" || name == "force_z") return "N";  // output.wall_loads
+  if (name == "torque") return "N m";
   return "";
 }
 
@@ -146,7 +150,15 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     substeps.push_back(n);
     sd->set_threads(threads_requested);
+    sd->set_record_contacts(!ck && contact_sample.enabled());  // the outputs at t = 0 (wall loads, contacts)
     if (!ck) sd->setup();
+  }
+  if (!ck && contact_sample.enabled()) {
+    contact_sample.begin(0.0);
+    for (std::size_t k = 0; k < subdomains.size(); ++k) {
+      contact_sample.take(k, *subdomains[k], walls);
+      subdomains[k]->set_record_contacts(false);
+    }
   }
   if (ck) {
     if (!restore_checkpoint(*ck, *this))
@@ -169,6 +181,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     columns.push_back(rm.name + ".particles");
   }
   for (const auto& c : flow.columns()) columns.push_back(c);
+  for (const auto& c : contact_sample.columns()) columns.push_back(c);
   if (!ck) flow.start(subdomains);
 
   // Cell grids: accessible volume from the walls present at the start.
@@ -198,9 +211,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     samplers.push_back({&c->fine_grid(), c->spec().fine, &c->timing().averaging});
     samplers.push_back({&c->coarse_grid(), c->spec().coarse, &c->timing().averaging});
   }
-  auto step_subdomain = [&](std::size_t k) {
+  // One step of subdomain k; `for_outputs`: its contacts go to the contact
+  // sample of the outputs at the step's end (wall loads, contact files).
+  auto step_subdomain = [&](std::size_t k, bool for_outputs) {
     Subdomain& sd = *subdomains[k];
-    bool record = false;
+    bool record = for_outputs;
     for (const auto& s : samplers) record = record || (s.subdomain == k && s.grid->due(sd.steps() + 1));
     sd.set_record_contacts(record);
     sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
@@ -212,6 +227,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       s.grid->sample(sd.store(), records, sd.time());
       if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
+    if (for_outputs) contact_sample.take(k, sd, walls);
     sd.set_record_contacts(false);
   };
   // The couplings' exchange, after the flow's own before-step work: at every
@@ -272,6 +288,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
   std::unique_ptr<io::VtkSeriesWriter> vtk;
   if (vtk_interval > 0) vtk = std::make_unique<io::VtkSeriesWriter>(out, "particles");
+  std::unique_ptr<io::WallSurfaceSeries> wall_vtk;
+  if (vtk && wall_surfaces && !walls.empty()) wall_vtk = std::make_unique<io::WallSurfaceSeries>(out, "walls");
+  std::unique_ptr<io::ContactSeriesWriter> contact_vtk;
+  if (contact_sample.wants_rows() && contact_interval > 0)
+    contact_vtk = std::make_unique<io::ContactSeriesWriter>(out, "contacts");
   auto write_probes = [&](double t) {
     std::vector<double> row = {t};
     for (const auto& sd : subdomains) {
@@ -288,14 +309,21 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     flow.check_planes(subdomains);
     flow.append_row(t, row);
+    contact_sample.append_values(t, kTimeTolerance * macro, row);
     probes->append(row);
   };
   auto write_vtk = [&](double t) {
     std::vector<io::ParticleSet> sets;
     for (std::size_t k = 0; k < subdomains.size(); ++k)
-      sets.push_back({&subdomains[k]->store(), static_cast<int>(k)});
+      sets.push_back({&subdomains[k]->store(), static_cast<int>(k), static_cast<int>(subdomains[k]->material())});
     vtk->write(t, sets);
+    if (wall_vtk) wall_vtk->write(t, walls, scene_lo, scene_hi);
     if (probes) probes->flush();  // probes.csv reaches the frame just written
+  };
+  auto write_contacts = [&](double t) {
+    const std::vector<io::ContactRow>* rows = contact_sample.rows_at(t, kTimeTolerance * macro);
+    if (!rows) spdlog::warn("contacts: no contacts were recorded for t = {:.6g} s; its file is empty", t);
+    contact_vtk->write(t, rows ? *rows : std::vector<io::ContactRow>{});
   };
 
   std::size_t particles = 0;
@@ -306,6 +334,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
 
   Interval probe_rows(probes ? probe_interval : 0.0, 0.0, macro);
   Interval vtk_frames(vtk ? vtk_interval : 0.0, 0.0, macro);
+  Interval contact_frames(contact_vtk ? contact_interval : 0.0, 0.0, macro);
   Interval checkpoints(checkpoint_interval, checkpoint_interval, macro);
   std::uint64_t m = 0;
   if (ck) {
@@ -323,6 +352,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (probes && ck->loop.probe_bytes > 0) probes->resume(ck->loop.probe_bytes);
     if (vtk) vtk->resume(ck->loop.vtk_times);
     const ArchiveReader& r = *ck->archive;
+    // the contact sample and files (sections absent when the checkpointed run had none)
+    if (contact_sample.enabled() && r.has("contacts/time")) contact_sample.load(r, "contacts/");
+    if (contact_vtk && r.has("contacts/frames")) {
+      resume(contact_frames, r.scalar<std::uint64_t>("contacts/frames"), r.scalar<double>("contacts/period"));
+      contact_vtk->resume(r.get<double>("contacts/frame_times"));
+    }
+    if (wall_vtk && r.has("walls/frame_times")) wall_vtk->resume(r.get<double>("walls/frame_times"));
     for (std::size_t g = 0; g < grids.size(); ++g) {
       const std::string p = "grid" + std::to_string(g) + "/";
       grids[g]->load(r, p);
@@ -366,6 +402,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       }
       for (std::size_t k = 0; k < couplings.size(); ++k) couplings[k]->save(w, "coupling" + std::to_string(k) + "/");
       if (fluid) fluid->save(w, "fluid/");
+      if (contact_sample.enabled()) contact_sample.save(w, "contacts/");
+      if (contact_vtk) {
+        w.put_scalar("contacts/frames", contact_frames.index());
+        w.put_scalar("contacts/period", contact_frames.period());
+        w.put("contacts/frame_times", contact_vtk->frame_times());
+      }
+      if (wall_vtk) w.put("walls/frame_times", wall_vtk->frame_times());
     });
     spdlog::debug("checkpoint at t = {:.6g} s written in {:.3g} s", ls.time,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -408,6 +451,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     if (probe_rows.take(t)) write_probes(t);
     if (vtk_frames.take(t)) write_vtk(t);
+    if (contact_frames.take(t)) write_contacts(t);
     if ((!grids.empty() || !couplings.empty()) && m > 0) {
       write_grids(t, false);
       refresh_accessible(t);
@@ -417,8 +461,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (fluid && m < stop) fluid->write_fields(t, false, out);
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
+    // the contacts of the macro step's last steps, when an output at its end needs them
+    const double t_end = static_cast<double>(m + 1) * macro;
+    const bool sample = contact_sample.enabled() && ((probes && contact_sample.has_probes() && probe_rows.due(t_end)) ||
+                                                     contact_frames.due(t_end));
+    if (sample) contact_sample.begin(t_end);
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
-      for (int s = 0; s < substeps[k]; ++s) step_subdomain(k);
+      for (int s = 0; s < substeps[k]; ++s) step_subdomain(k, sample && s == substeps[k] - 1);
       const double ps = static_cast<double>(substeps[k]) * static_cast<double>(subdomains[k]->size());
       particle_steps += ps;
       if (options.time_after && m >= options.time_after) window_particle_steps += ps;
@@ -491,7 +540,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                     {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)}});
   summary["plugin_libraries"] = libs;
   summary["models"] = models_used;
-  nlohmann::json files = {{"probes", probes ? "probes.csv" : ""}, {"particles", vtk ? "particles.pvd" : ""}};
+  nlohmann::json files = {{"probes", probes ? "probes.csv" : ""},
+                          {"particles", vtk ? "particles.pvd" : ""},
+                          {"walls", wall_vtk ? "walls.pvd" : ""},
+                          {"contacts", contact_vtk ? "contacts.pvd" : ""}};
   nlohmann::json sds = nlohmann::json::array();
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
     const auto& sd = subdomains[k];

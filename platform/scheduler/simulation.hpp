@@ -11,6 +11,7 @@
 #include "fluid/fluid_coupling.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
+#include "scheduler/contact_sample.hpp"
 #include "scheduler/particle_flow.hpp"
 #include "scheduler/schedule.hpp"
 #include "subdomain/repose_probe.hpp"
@@ -70,7 +71,8 @@ class Simulation {
   std::string name;
   std::filesystem::path scenario_file;
   std::vector<Material> materials;
-  std::vector<WallPrimitive> walls;
+  std::vector<WallPrimitive> walls;    ///< the scenario walls' primitives at time 0
+  std::vector<std::string> wall_names;  ///< the scenario walls (WallPrimitive::wall indexes it)
   std::vector<std::unique_ptr<Subdomain>> subdomains;
   std::vector<TimeStepReport> time_steps;  ///< per subdomain
   double gravity[3] = {0, 0, 0};  ///< [m/s^2] the scenario's (its schema default when omitted)
@@ -84,6 +86,10 @@ class Simulation {
   bool write_state = false;  ///< output.state: <subdomain>_state.csv at the end (io/particle_state.hpp)
   std::optional<ReposeProbeSettings> repose_probe;  ///< adds <subdomain>.repose_angle_deg to probes.csv
   std::vector<RegionMassProbe> region_mass;         ///< output.region_mass
+  ContactSample contact_sample;  ///< output.wall_loads and output.contacts (scheduler/contact_sample.hpp)
+  double contact_interval = 0;   ///< [s] between contact files (output.contacts); 0: none
+  bool wall_surfaces = true;     ///< output.wall_surfaces: walls.pvd with the particle frames
+  double scene_lo[3] = {0, 0, 0}, scene_hi[3] = {0, 0, 0};  ///< where unbounded walls are drawn
   std::filesystem::path output_directory;
   nlohmann::json models_used;  ///< per subdomain: slot -> {model, version, library}
   ParticleFlow flow;           ///< pours, deletion regions, mass-flow planes, mass balance

@@ -80,6 +80,11 @@ class Subdomain {
   int threads() const { return pool_->size(); }
   double time_step() const { return dt_; }
 
+  /// The pair coefficients of its particle pairs and of each wall primitive
+  /// (friction, restitution, E*, G*), as its contact kernels see them.
+  const domel_pair_v2& self_pair() const { return self_pair_; }
+  const std::vector<domel_pair_v2>& wall_pairs() const { return wall_pairs_; }
+
   /// The body-force list (gravity; the store's external forces once enabled).
   const BodyForces& body_forces() const { return body_forces_; }
   /// Reset the forces of particles [first, last) to their body forces: for

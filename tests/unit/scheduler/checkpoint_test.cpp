@@ -164,6 +164,26 @@ json water_bed(const std::string& backend) {
   return d;
 }
 
+json hopper_with_loads() {
+  // the hopper example with the loads on both walls in probes.csv every two
+  // steps and contact files every 500: a restart at an even step starts
+  // from the contact sample the checkpoint holds for its first row and file
+  json d = read_json("scenarios/examples/hopper.json");
+  d["walls"][1]["file"] = std::string(DOMEL_SOURCE_DIR) + "/scenarios/examples/chute.stl";
+  d["subdomains"][0]["time_step"] = 4e-6;
+  d["run"]["duration"] = 0.1;
+  d["output"]["probe_interval"] = 8e-6;
+  d["output"]["vtk_interval"] = 0.01;
+  d["output"]["contacts"] = {{"interval", 0.002}};
+  d["output"]["wall_loads"] = {{{"wall", "hopper"}}, {{"wall", "chute"}}};
+  return d;
+}
+
+TEST(Checkpoint, WallLoadsContactAndWallFilesRestartedAreBitIdentical) {
+  // stopped at t = 0.08 s (a probe row and a contact file are due), the grains in the hopper
+  for (int threads : {1, 2}) expect_restart_identical(hopper_with_loads(), "hopper_loads", 20000, 0.03, threads);
+}
+
 TEST(Checkpoint, SettleRestartedIsBitIdentical) {
   for (int threads : {1, 2}) expect_restart_identical(settle(), "settle", 2345, 0.007, threads);
 }

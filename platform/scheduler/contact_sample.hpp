@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: MIT
+// What the contacts of one output time give the outputs: the load on walls
+// (output.wall_loads: force and torque about an axis, in probes.csv) and the
+// contact rows of output.contacts (io/contact_writer.hpp). The run loop asks
+// every subdomain to record its contact forces in the last step before an
+// output time (Subdomain::set_record_contacts) and hands them to take(); the
+// outputs written at that time read the sample. A sample belongs to one
+// time; asked for another, the wall loads are NaN and no contact frame is
+// written.
+#pragma once
+
+#include "geometry/wall.hpp"
+#include "io/contact_writer.hpp"
+#include "scheduler/particle_flow.hpp"
+
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace domel::platform {
+
+class Subdomain;
+class ArchiveWriter;
+class ArchiveReader;
+
+/// output.wall_loads[k]: the load the particles put on one scenario wall.
+struct WallLoadProbe {
+  std::string name;                        ///< column prefix (the wall's name)
+  std::size_t wall = 0;                    ///< index of the scenario wall
+  std::size_t subdomain = kAllSubdomains;  ///< the only subdomain counted, or all
+  bool has_axis = false;                   ///< the torque column is written
+  double point[3] = {0, 0, 0};             ///< a point on the torque axis [m]
+  double axis[3] = {0, 0, 1};              ///< its unit direction
+};
+
+class ContactSample {
+ public:
+  void configure(std::vector<WallLoadProbe> probes, bool rows);
+  bool enabled() const { return !probes_.empty() || rows_wanted_; }
+  bool has_probes() const { return !probes_.empty(); }
+  bool wants_rows() const { return rows_wanted_; }
+  const std::vector<WallLoadProbe>& probes() const { return probes_; }
+
+  /// The probes' columns of probes.csv: <name>.force_x, .force_y, .force_z
+  /// [N], and <name>.torque [N m] when the probe has an axis.
+  std::vector<std::string> columns() const;
+
+  /// Start the sample of time t (forgetting the last one).
+  void begin(double t);
+  /// Add subdomain k's contacts of its last force evaluation (recorded:
+  /// Subdomain::set_record_contacts) at the sample's time. `walls` are the
+  /// scenario's wall primitives, as the subdomain indexes them.
+  void take(std::size_t k, const Subdomain& sd, const std::vector<WallPrimitive>& walls);
+
+  /// Append the probes' values at time t to a probes.csv row: the sample's
+  /// when it was taken at t (within `tolerance` s), NaN otherwise.
+  void append_values(double t, double tolerance, std::vector<double>& row) const;
+  /// The contact rows of the sample at t, or null when it was not taken at t.
+  const std::vector<io::ContactRow>* rows_at(double t, double tolerance) const;
+
+  /// Checkpoints: the sample held for the next outputs (taken at the end of
+  /// the macro step before the checkpoint, written after it).
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void load(const ArchiveReader& r, const std::string& prefix);
+
+ private:
+  std::vector<WallLoadProbe> probes_;
+  bool rows_wanted_ = false;
+  double time_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> sums_;  ///< per probe: force x, y, z on the wall, torque about its axis
+  std::vector<io::ContactRow> rows_;
+};
+
+}  // namespace domel::platform
