@@ -62,38 +62,51 @@ ContactPipeline::Workspace::Workspace(uint32_t history_stride) {
 void ContactPipeline::evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const {
   ws.batch.pair = &pair;  // one pair for the batch: read once per batch by the kernels (abi.h)
   ws.batch.pair_of = nullptr;
-  run_stages(ws, dt, n);
+  run_stages(ws.batch, ws.buf.history.data(), dt, n);
 }
 
 void ContactPipeline::evaluate(Workspace& ws, double dt, uint32_t n) const {
   ws.batch.pair = nullptr;
   ws.batch.pair_of = ws.buf.pair_of.data();
-  run_stages(ws, dt, n);
+  run_stages(ws.batch, ws.buf.history.data(), dt, n);
 }
 
-void ContactPipeline::run_stages(Workspace& ws, double dt, uint32_t n) const {
-  auto& b = ws.batch;
-  auto& buf = ws.buf;
+void ContactPipeline::evaluate_range(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t first,
+                                     uint32_t n) const {
+  if (first == 0) return evaluate(ws, pair, dt, n);
+  domel_contact_batch_v2 b = ws.batch;  // the same arrays, from contact `first` on
+  b.pair = &pair;
+  b.pair_of = nullptr;
+  for (const double** p : {&b.overlap, &b.nx, &b.ny, &b.nz, &b.r_eff, &b.m_eff, &b.radius_i, &b.radius_j, &b.mass_i,
+                           &b.mass_j, &b.vn, &b.vtx, &b.vty, &b.vtz, &b.wx, &b.wy, &b.wz})
+    *p += first;
+  for (double** p : {&b.fn_elastic, &b.kn, &b.kn_tangent, &b.contact_radius, &b.fn_damping, &b.eta_n, &b.fn, &b.ftx,
+                     &b.fty, &b.ftz, &b.tqx, &b.tqy, &b.tqz, &b.rolling_stiffness, &b.rolling_damping})
+    *p += first;
+  run_stages(b, ws.buf.history.data() + static_cast<std::size_t>(first) * history_stride_, dt, n);
+}
+
+void ContactPipeline::run_stages(domel_contact_batch_v2& b, double* history, double dt, uint32_t n) const {
   b.n = n;
   b.dt = dt;
   auto run = [&](Slot s) {
     const auto& inst = slots_[static_cast<int>(s)];
     if (!inst) return;
-    b.history = buf.history.data() + offset_[static_cast<int>(s)];
+    b.history = history + offset_[static_cast<int>(s)];
     inst->contact(b);
   };
   run(Slot::normal);
   run(Slot::damping);
-  for (uint32_t c = 0; c < n; ++c) buf.fn[c] = buf.fn_elastic[c] + buf.fn_damping[c];
+  for (uint32_t c = 0; c < n; ++c) b.fn[c] = b.fn_elastic[c] + b.fn_damping[c];
   run(Slot::tangential);
   if (has_torque()) {  // else they stay zero from the workspace's construction: only these slots write them
-    std::fill_n(buf.tqx.begin(), n, 0.0);
-    std::fill_n(buf.tqy.begin(), n, 0.0);
-    std::fill_n(buf.tqz.begin(), n, 0.0);
+    std::fill_n(b.tqx, n, 0.0);
+    std::fill_n(b.tqy, n, 0.0);
+    std::fill_n(b.tqz, n, 0.0);
   }
   if (slots_[static_cast<int>(Slot::rolling)]) {
-    std::fill_n(buf.rolling_stiffness.begin(), n, 0.0);
-    std::fill_n(buf.rolling_damping.begin(), n, 0.0);
+    std::fill_n(b.rolling_stiffness, n, 0.0);
+    std::fill_n(b.rolling_damping, n, 0.0);
   }
   run(Slot::rolling);
   run(Slot::twisting);

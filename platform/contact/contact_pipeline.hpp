@@ -92,6 +92,10 @@ class ContactPipeline {
   void evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const;
   /// The same for a batch of several pairs: contact c uses *ws.buf.pair_of[c].
   void evaluate(Workspace& ws, double dt, uint32_t n) const;
+  /// Evaluate contacts [first, first + n) of a workspace, all of one pair:
+  /// a run of a batch grouped by material pair (the kernels see a batch
+  /// that starts at `first`).
+  void evaluate_range(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t first, uint32_t n) const;
 
   /// The pipeline's own workspace, for single-threaded callers.
   Buffers& buffers() { return main_->buf; }
@@ -103,7 +107,8 @@ class ContactPipeline {
   uint32_t history_stride_ = 0;
   bool reads_masses_ = false;
   std::unique_ptr<Workspace> main_;
-  void run_stages(Workspace& ws, double dt, uint32_t n) const;
+  /// The stages on batch b (its arrays may start inside the workspace's).
+  void run_stages(domel_contact_batch_v2& b, double* history, double dt, uint32_t n) const;
 };
 
 }  // namespace domel::platform

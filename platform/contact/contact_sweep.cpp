@@ -111,7 +111,25 @@ inline void add(const ForceAccumulator& a, uint32_t k, double fx, double fy, dou
   a.tx[k] += tx; a.ty[k] += ty; a.tz[k] += tz;
 }
 
-template <bool kZoned, bool kTorque, bool kMasses>
+/// Group the first c entries of a batch by key (a stable counting sort:
+/// list order within a key) and return the runs as (first slot, key) in
+/// `runs` (closed by (c, -)). `key_of(entry)` < n_keys.
+template <class KeyOf>
+void group_by_key(uint32_t* entry, uint32_t c, uint32_t n_keys, KeyOf&& key_of, std::vector<uint32_t>& count,
+                  std::vector<uint32_t>& sorted, std::vector<std::pair<uint32_t, uint32_t>>& runs) {
+  count.assign(n_keys + 1, 0);
+  sorted.resize(c);
+  for (uint32_t q = 0; q < c; ++q) ++count[key_of(entry[q]) + 1];
+  for (uint32_t k = 0; k < n_keys; ++k) count[k + 1] += count[k];
+  runs.clear();
+  for (uint32_t k = 0; k < n_keys; ++k)
+    if (count[k + 1] > count[k]) runs.emplace_back(count[k], k);
+  runs.emplace_back(c, 0);
+  for (uint32_t q = 0; q < c; ++q) sorted[count[key_of(entry[q])]++] = entry[q];
+  std::copy_n(sorted.begin(), c, entry);
+}
+
+template <bool kZoned, bool kTorque, bool kMasses, bool kMixed>
 void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, ContactScratch& ts, std::size_t own_lo,
                 std::size_t own_hi, const ForceAccumulator& own, const ForceAccumulator& shared) {
   const ParticleStore& s = *sw.store;
@@ -163,6 +181,15 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       c += in;
     }
     if (c == 0) continue;
+    // Several materials: the batch's contacts grouped by material pair, so
+    // that each run of one pair is evaluated with its own constants.
+    const uint8_t* __restrict mat = s.material.data();
+    const uint32_t nm = sw.n_materials;
+    if constexpr (kMixed)
+      group_by_key(entry, c, nm * nm, [&](uint32_t le) {
+        const uint32_t a = mat[li[le]], b = mat[lj[le]];
+        return a < b ? a * nm + b : b * nm + a;  // (a, b) and (b, a) share their constants: one run
+      }, ts.key_count, ts.sorted, ts.runs);
     // Phase B: the gather (contact geometry and relative velocities).
     for (uint32_t q = 0; q < c; ++q) {
       const uint32_t le = entry[q];
@@ -192,7 +219,13 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       max_ratio = std::max(max_ratio, delta * inv_rsum);
     }
     try {
-      sw.pipeline->evaluate(*ts.ws, *sw.pair, sw.dt, c);
+      if constexpr (kMixed) {
+        for (std::size_t r = 0; r + 1 < ts.runs.size(); ++r)
+          sw.pipeline->evaluate_range(*ts.ws, sw.pairs[ts.runs[r].second], sw.dt, ts.runs[r].first,
+                                      ts.runs[r + 1].first - ts.runs[r].first);
+      } else {
+        sw.pipeline->evaluate(*ts.ws, sw.pairs[0], sw.dt, c);
+      }
     } catch (const PluginError& err) {
       throw_batch_failure(err, s, entry, c, li, [&](uint32_t le) { return "particle id " + std::to_string(s.id[lj[le]]); });
     }
@@ -238,16 +271,19 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
 }  // namespace
 
 namespace {
-template <bool kMasses>
+template <bool kMasses, bool kMixed>
 PairRangeFn pair_kernel_of(bool has_torque, bool zoned) {
-  if (has_torque) return zoned ? &pair_range<true, true, kMasses> : &pair_range<false, true, kMasses>;
-  return zoned ? &pair_range<true, false, kMasses> : &pair_range<false, false, kMasses>;
+  if (has_torque) return zoned ? &pair_range<true, true, kMasses, kMixed> : &pair_range<false, true, kMasses, kMixed>;
+  return zoned ? &pair_range<true, false, kMasses, kMixed> : &pair_range<false, false, kMasses, kMixed>;
 }
 }  // namespace
 
-PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned) {
-  return pipeline.reads_masses() ? pair_kernel_of<true>(pipeline.has_torque(), zoned)
-                                 : pair_kernel_of<false>(pipeline.has_torque(), zoned);
+PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed) {
+  if (mixed)
+    return pipeline.reads_masses() ? pair_kernel_of<true, true>(pipeline.has_torque(), zoned)
+                                   : pair_kernel_of<false, true>(pipeline.has_torque(), zoned);
+  return pipeline.reads_masses() ? pair_kernel_of<true, false>(pipeline.has_torque(), zoned)
+                                 : pair_kernel_of<false, false>(pipeline.has_torque(), zoned);
 }
 
 void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std::size_t last) {
@@ -270,10 +306,19 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
     const std::size_t e_first = static_cast<std::size_t>(lo - list.particle.begin());
     const std::size_t e_last = static_cast<std::size_t>(hi - list.particle.begin());
     uint32_t c = 0;
+    // this wall's pair constants, by the particle's local material
+    const domel_pair_v2* wall_pairs = sw.pairs + w * sw.n_materials;
+    const bool mixed = sw.n_materials > 1;
     auto flush = [&]() {
       if (c == 0) return;
       try {
-        sw.pipeline->evaluate(*ts.ws, (*sw.pairs)[w], sw.dt, c);
+        if (!mixed) {
+          sw.pipeline->evaluate(*ts.ws, wall_pairs[0], sw.dt, c);
+        } else {
+          for (std::size_t r = 0; r + 1 < ts.runs.size(); ++r)
+            sw.pipeline->evaluate_range(*ts.ws, wall_pairs[ts.runs[r].second], sw.dt, ts.runs[r].first,
+                                        ts.runs[r + 1].first - ts.runs[r].first);
+        }
       } catch (const PluginError& err) {
         throw_batch_failure(err, s, ts.entry.data(), c, list.particle.data(),
                             [&](uint32_t) { return "wall '" + wall.name + "'"; });
@@ -299,7 +344,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
     // The wall is partner j: no radius, no rotation, its surface velocity
     // at the contact point x_i - c_i n when it moves.
     const bool moving = wall.moving;
-    auto push = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
+    auto gather = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
       const double delta = s.radius[i] - d;
       const double ci = s.radius[i] - delta;
       double rx, ry, rz;
@@ -316,7 +361,34 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
       ts.entry[c] = static_cast<uint32_t>(e);
       ts.ci[c] = ci;
       max_ratio = std::max(max_ratio, delta / (2.0 * s.radius[i]));
-      if (++c == ContactPipeline::kBatchSize) flush();
+      ++c;
+    };
+    // Several materials: the contacts are staged, then grouped by the
+    // particle's material before the gather, so that each run of one wall
+    // pair is evaluated with its own constants.
+    auto flush_staged = [&]() {
+      if (ts.staged.empty()) return;
+      const auto n = static_cast<uint32_t>(ts.staged.size());
+      for (uint32_t q = 0; q < n; ++q) ts.entry[q] = q;
+      group_by_key(ts.entry.data(), n, sw.n_materials,
+                   [&](uint32_t k) { return static_cast<uint32_t>(s.material[ts.staged[k].particle]); }, ts.key_count,
+                   ts.sorted, ts.runs);
+      for (uint32_t q = 0; q < n; ++q) ts.sorted[q] = ts.entry[q];  // gather() overwrites entry[]
+      for (uint32_t q = 0; q < n; ++q) {
+        const auto& k = ts.staged[ts.sorted[q]];
+        gather(k.entry, k.particle, k.d, k.nx, k.ny, k.nz);
+      }
+      ts.staged.clear();
+      flush();
+    };
+    auto push = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
+      if (!mixed) {
+        gather(e, i, d, nx, ny, nz);
+        if (c == ContactPipeline::kBatchSize) flush();
+        return;
+      }
+      ts.staged.push_back({static_cast<uint32_t>(e), i, d, nx, ny, nz});
+      if (ts.staged.size() == ContactPipeline::kBatchSize) flush_staged();
     };
     if (wall.shape == WallPrimitive::Shape::mesh) {
       // Per particle: the counted features of its candidate triangles
@@ -355,6 +427,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
           std::fill_n(list.history.begin() + static_cast<std::ptrdiff_t>(released * stride), stride, 0.0);
         e = e_end;
       }
+      flush_staged();
       flush();
       continue;
     }
@@ -371,6 +444,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
       }
       push(e, i, d, nx, ny, nz);
     }
+    flush_staged();
     flush();
   }
   ts.wall_contacts += contacts;

@@ -49,6 +49,16 @@ struct ContactScratch {
   std::vector<uint32_t> entry;         ///< list entry of each batch slot
   std::vector<double> ci, cj;          ///< lever arms of each batch slot
   std::vector<ContactRecord> records;  ///< contact forces on recording steps
+  /// Several materials: the batch's grouping by material pair (counts,
+  /// the sorted entries, the runs as (first slot, pair)) and the wall
+  /// contacts staged before it.
+  std::vector<uint32_t> key_count, sorted;
+  std::vector<std::pair<uint32_t, uint32_t>> runs;
+  struct WallCandidate {
+    uint32_t entry, particle;
+    double d, nx, ny, nz;
+  };
+  std::vector<WallCandidate> staged;
   std::size_t pair_contacts = 0;
   double pair_max_ratio = 0;
   std::size_t wall_contacts = 0;
@@ -63,7 +73,8 @@ struct PairSweep {
   const ParticleStore* store;
   NeighborList* list;
   const ContactPipeline* pipeline;
-  const domel_pair_v2* pair;
+  const domel_pair_v2* pairs;  ///< [a * n_materials + b], by the particles' local materials
+  uint32_t n_materials;
   double dt;
   bool record;  ///< append each contact's force to ContactScratch::records
 };
@@ -76,15 +87,18 @@ using PairRangeFn = void (*)(const PairSweep&, std::size_t first, std::size_t la
                              std::size_t own_lo, std::size_t own_hi, const ForceAccumulator& own,
                              const ForceAccumulator& shared);
 /// The pair_range instance for a pipeline (with or without a couple, with or
-/// without the masses its stages read), with or without zones.
-PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned);
+/// without the masses its stages read), with or without zones, for one
+/// material or several (`mixed`: each batch is grouped by material pair and
+/// evaluated run by run; one material keeps the single-pair path).
+PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed);
 
 /// The inputs of the wall sweep of one force evaluation.
 struct WallSweep {
   ParticleStore* store;
   std::vector<WallNeighbors>* lists;
   const std::vector<WallPrimitive>* walls;   ///< placed at wall_time
-  const std::vector<domel_pair_v2>* pairs;   ///< per wall
+  const domel_pair_v2* pairs;                ///< [w * n_materials + a], per wall and particle material
+  uint32_t n_materials;
   const ContactPipeline* pipeline;
   double dt;
   double forces_time;  ///< the force evaluation's time (which walls are active)

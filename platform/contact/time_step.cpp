@@ -13,23 +13,32 @@ namespace domel::platform {
 TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore& s, double impact_velocity) {
   TimeStepReport rep;
   if (s.size() == 0) return rep;
-  std::size_t smallest = 0;
-  for (std::size_t k = 1; k < s.size(); ++k)
-    if (s.radius[k] < s.radius[smallest]) smallest = k;
-  const double r = s.radius[smallest];
-  const double m = s.mass[smallest];
-  // Rayleigh time, docs/physics.md §1.3.
-  const double nu = in.material->poisson_ratio;
-  const double g_mod = in.material->youngs_modulus / (2.0 * (1.0 + nu));
-  rep.rayleigh = M_PI * r * std::sqrt(in.material->density / g_mod) / (0.1631 * nu + 0.8766);
+  const std::size_t n_mat = in.materials->size();
+  // the smallest particle of each material present
+  std::vector<std::size_t> smallest(n_mat, SIZE_MAX);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    std::size_t& q = smallest[s.material[k]];
+    if (q == SIZE_MAX || s.radius[k] < s.radius[q]) q = k;
+  }
+  // Rayleigh time, docs/physics.md §1.3: the shortest of the materials present.
+  bool first = true;
+  for (std::size_t a = 0; a < n_mat; ++a) {
+    if (smallest[a] == SIZE_MAX) continue;
+    const Material& mat = (*in.materials)[a];
+    const double nu = mat.poisson_ratio;
+    const double g_mod = mat.youngs_modulus / (2.0 * (1.0 + nu));
+    const double t = M_PI * s.radius[smallest[a]] * std::sqrt(mat.density / g_mod) / (0.1631 * nu + 0.8766);
+    rep.rayleigh = first ? t : std::min(rep.rayleigh, t);
+    first = false;
+  }
 
   auto& buf = in.pipeline->buffers();
   // i_red: rotational inertia of the relative rolling mode (pair of equal
   // spheres: I/2; sphere on a wall: I), for the rolling spring's own limit
   // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
   // (docs/physics.md §3.6).
-  auto collide = [&](const domel_pair_v2& pair, double r_i, double r_j, double m_eff, double i_red,
-                     double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
+  auto collide = [&](const domel_pair_v2& pair, double r_i, double r_j, double m_i, double m_j, double m_eff,
+                     double i_red, double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
     const double r_eff = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
     // contact opens, with a step refined until the duration converges.
@@ -41,7 +50,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
       auto force = [&](double d, double vel) {
         buf.overlap[0] = std::max(d, 1e-300);
         buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_i; buf.radius_j[0] = r_j;
-        buf.mass_i[0] = r_j > 0 ? 2.0 * m_eff : m_eff; buf.mass_j[0] = r_j > 0 ? 2.0 * m_eff : 0.0;  // equal spheres or a wall
+        buf.mass_i[0] = m_i; buf.mass_j[0] = m_j;  // m_j = 0: a wall
         buf.nx[0] = 0; buf.ny[0] = 0; buf.nz[0] = 1; buf.vn[0] = vel;
         buf.vtx[0] = buf.vty[0] = buf.vtz[0] = 0; buf.wx[0] = buf.wy[0] = buf.wz[0] = 0;
         std::fill(buf.history.begin(), buf.history.end(), 0.0);
@@ -84,22 +93,47 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     }
     std::fill(buf.history.begin(), buf.history.end(), 0.0);
   };
-  const double inertia = 0.4 * m * r * r;  // solid sphere
   double tc, crit;
   bool rolling = false;
-  collide(*in.self_pair, r, r, 0.5 * m, 0.5 * inertia, tc, crit, rolling);
-  rep.contact_time = tc;
-  rep.critical = crit;
-  rep.critical_of = rolling ? "rolling spring of the particle-particle contact" : "particle-particle contact";
-  for (std::size_t w = 0; w < in.wall_pairs->size(); ++w) {
-    collide((*in.wall_pairs)[w], r, 0.0, m, inertia, tc, crit, rolling);
-    rep.contact_time = std::min(rep.contact_time, tc);
-    if (crit < rep.critical) {
+  first = true;
+  // "particle-particle contact", or with several materials the pair's names
+  auto pair_name = [&](std::size_t a, std::size_t b) {
+    return n_mat == 1 ? std::string("particle-particle contact")
+                      : "contact of " + (*in.materials)[a].name + " with " + (*in.materials)[b].name;
+  };
+  auto keep = [&](const std::string& what) {
+    if (first || tc < rep.contact_time) rep.contact_time = tc;
+    if (first || crit < rep.critical) {
       rep.critical = crit;
-      rep.critical_of = std::string(rolling ? "rolling spring of the " : "") + "contact with wall '" +
-                        (*in.walls)[w].name + "'";
+      rep.critical_of = (rolling ? "rolling spring of the " : "") + what;
+    }
+    first = false;
+  };
+  for (std::size_t a = 0; a < n_mat; ++a) {
+    if (smallest[a] == SIZE_MAX) continue;
+    const double ra = s.radius[smallest[a]], ma = s.mass[smallest[a]];
+    const double ia = 0.4 * ma * ra * ra;  // solid sphere
+    for (std::size_t b = a; b < n_mat; ++b) {
+      if (smallest[b] == SIZE_MAX) continue;
+      if (b == a) {  // a pair of equal spheres: m* = m/2, the relative rolling mode's inertia I/2
+        collide((*in.pairs)[a * n_mat + a], ra, ra, ma, ma, 0.5 * ma, 0.5 * ia, tc, crit, rolling);
+      } else {
+        const double rb = s.radius[smallest[b]], mb = s.mass[smallest[b]];
+        const double ib = 0.4 * mb * rb * rb;
+        collide((*in.pairs)[a * n_mat + b], ra, rb, ma, mb, ma * mb / (ma + mb), ia * ib / (ia + ib), tc, crit,
+                rolling);
+      }
+      keep(pair_name(a, b));
     }
   }
+  for (std::size_t w = 0; w < in.walls->size(); ++w)
+    for (std::size_t a = 0; a < n_mat; ++a) {
+      if (smallest[a] == SIZE_MAX) continue;
+      const double ra = s.radius[smallest[a]], ma = s.mass[smallest[a]];
+      collide((*in.wall_pairs)[w * n_mat + a], ra, 0.0, ma, 0.0, ma, 0.4 * ma * ra * ra, tc, crit, rolling);
+      keep(std::string("contact with wall '") + (*in.walls)[w].name + "'" +
+           (n_mat == 1 ? "" : " (" + (*in.materials)[a].name + ")"));
+    }
   return rep;
 }
 

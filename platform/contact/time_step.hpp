@@ -30,15 +30,17 @@ struct TimeStepReport {
 /// The contacts a time step is estimated for.
 struct TimeStepInputs {
   ContactPipeline* pipeline;
-  const Material* material;
-  const domel_pair_v2* self_pair;
-  const std::vector<domel_pair_v2>* wall_pairs;  ///< per wall
+  const std::vector<Material>* materials;        ///< the subdomain's, by local index (ParticleStore::material)
+  const std::vector<domel_pair_v2>* pairs;       ///< [a * n + b]
+  const std::vector<domel_pair_v2>* wall_pairs;  ///< [w * n + a]
   const std::vector<WallPrimitive>* walls;       ///< names, for the report
 };
 
-/// Rayleigh time, contact time and stability limit for the smallest
-/// particle of `s` colliding at `impact_velocity` (chosen and reason left
-/// empty). Throws PluginError when a stage fails.
+/// Rayleigh time, contact time and stability limit at `impact_velocity`
+/// (chosen and reason left empty): for each material present, its smallest
+/// particle of `s`, colliding with the smallest of every material (itself
+/// included) and with every wall; the shortest times are reported. Throws
+/// PluginError when a stage fails.
 TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore& s, double impact_velocity);
 
 /// What is wrong with a given time step, and how to fix it (empty: nothing).

@@ -17,10 +17,13 @@ struct Material {
   double poisson_ratio = 0.0;   ///< [-]
 };
 
-/// Restitution and friction of one pair of materials.
+/// Restitution, friction and (when the scenario gives it) the rolling
+/// friction of one pair of materials.
 struct PairCoefficients {
   double restitution = 0.0;
   double friction = 0.0;
+  double rolling_friction = 0.0;  ///< mu_r of the pair; valid when has_rolling_friction
+  bool has_rolling_friction = false;
 };
 
 /// 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j ; 1/G* = 2(2-nu_i)(1+nu_i)/E_i + (same for j).
@@ -36,8 +39,9 @@ inline domel_pair_v2 make_pair(const Material& a, const Material& b, const PairC
   p.restitution = c.restitution;
   p.friction = c.friction;
   p.coarse_grain = coarse_grain;
-  // rolling_friction: not given (has_rolling_friction 0) until scenarios set
-  // it per material pair (the mixtures issue); the rolling model's own applies
+  // not given: the rolling model's own parameter applies (abi.h)
+  p.rolling_friction = c.has_rolling_friction ? c.rolling_friction : 0.0;
+  p.has_rolling_friction = c.has_rolling_friction ? 1u : 0u;
   return p;
 }
 

@@ -10,7 +10,7 @@
 namespace domel::platform {
 
 void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, double r,
-                        double density, bool fixed) {
+                        double density, bool fixed, std::uint8_t mat) {
   const double m = density * 4.0 / 3.0 * M_PI * r * r * r;
   const double inertia = 0.4 * m * r * r;  // solid sphere
   id.push_back(pid);
@@ -22,6 +22,7 @@ void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, doub
   inv_inertia.push_back(fixed ? 0.0 : 1.0 / inertia);
   contacts.push_back(0);
   flags.push_back(fixed ? kFixed : 0);
+  material.push_back(mat);
   if (external_force_)
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->push_back(0.0);
   for (auto& a : aux) a.push_back(0.0);
@@ -107,6 +108,7 @@ void ParticleStore::save(ArchiveWriter& w, const std::string& p) const {
   for (const auto& [name, member] : kRealArrays) w.put(p + name, this->*member);
   w.put(p + "contacts", contacts);
   w.put(p + "flags", flags);
+  w.put(p + "material", material);
   w.put_scalar<std::uint8_t>(p + "external_force", external_force_ ? 1 : 0);
   if (external_force_) {
     w.put(p + "ext_fx", ext_fx);
@@ -123,6 +125,8 @@ void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
   for (const auto& [name, member] : kRealArrays) r.get_into(p + name, this->*member);
   r.get_into(p + "contacts", contacts);
   r.get_into(p + "flags", flags);
+  if (r.has(p + "material")) r.get_into(p + "material", material);
+  else material.assign(id.size(), 0);  // a checkpoint from before materials per particle: one material
   external_force_ = r.scalar<std::uint8_t>(p + "external_force") != 0;
   if (external_force_) {
     r.get_into(p + "ext_fx", ext_fx);

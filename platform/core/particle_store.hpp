@@ -27,6 +27,10 @@ struct ParticleStore {
   std::vector<double> inv_inertia;         ///< 1/I, I = 2/5 m r^2 for a solid sphere [1/(kg m^2)]
   std::vector<std::uint32_t> contacts;     ///< contact count in the last force evaluation
   std::vector<std::uint8_t> flags;         ///< kFixed, ...
+  /// The particle's material, as an index into its subdomain's materials
+  /// (Subdomain::materials(): 0 is the subdomain's own; at most kMaxMaterials).
+  std::vector<std::uint8_t> material;
+  static constexpr std::size_t kMaxMaterials = 256;
   /// External force per particle [N] (controllers, fluid drag): the second
   /// entry of the body-force list (integrator.hpp), added to m g at every
   /// force reset. Empty until enable_external_force(); from then on it moves
@@ -65,8 +69,10 @@ struct ParticleStore {
   /// know they are stale without comparing ids every step.
   std::uint64_t layout_version = 0;
 
-  /// Append one particle at rest. Mass from density and radius.
-  void add(std::uint64_t pid, double px, double py, double pz, double r, double density, bool fixed = false);
+  /// Append one particle at rest. Mass from density and radius; `mat` is
+  /// its material's index in the subdomain's materials.
+  void add(std::uint64_t pid, double px, double py, double pz, double r, double density, bool fixed = false,
+           std::uint8_t mat = 0);
 
   /// Make room for n particles in every array, so that a block of known
   /// size (an insertion, a state file) is appended without the doubling
@@ -97,7 +103,7 @@ struct ParticleStore {
   void for_each_array(F&& f) {
     f(id); f(x); f(y); f(z); f(vx); f(vy); f(vz); f(wx); f(wy); f(wz);
     f(fx); f(fy); f(fz); f(tx); f(ty); f(tz);
-    f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts); f(flags);
+    f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts); f(flags); f(material);
     if (external_force_) {
       f(ext_fx); f(ext_fy); f(ext_fz);
     }

@@ -14,6 +14,7 @@ namespace domel::platform::io {
 namespace {
 
 constexpr const char* kHeader = "id,x,y,z,radius,vx,vy,vz,wx,wy,wz,fixed";
+constexpr const char* kHeaderV2 = "id,x,y,z,radius,vx,vy,vz,wx,wy,wz,fixed,material";
 constexpr int kColumns = 12;
 constexpr const char* kColumnNames[kColumns] = {"id", "x", "y", "z", "radius", "vx", "vy", "vz", "wx", "wy", "wz",
                                                 "fixed"};
@@ -36,16 +37,17 @@ std::string trim(const std::string& s) {
 }  // namespace
 
 std::string format_particle_state(const ParticleStore& st, const std::string& subdomain, double time,
-                                  double coarse_grain) {
+                                  double coarse_grain, const std::vector<std::string>& materials) {
+  const bool v2 = materials.size() > 1;
   std::string s;
   s.reserve(64 + st.size() * 230);
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "# domel particle state v1: subdomain '%s', %zu particles, t = %.17g s, coarse_grain %.17g\n"
+                "# domel particle state v%d: subdomain '%s', %zu particles, t = %.17g s, coarse_grain %.17g\n"
                 "# SI units; radius is the parcel radius (coarse grain applied); contact history is not stored\n",
-                subdomain.c_str(), st.size(), time, coarse_grain);
+                v2 ? 2 : 1, subdomain.c_str(), st.size(), time, coarse_grain);
   s += buf;
-  s += kHeader;
+  s += v2 ? kHeaderV2 : kHeader;
   s += '\n';
   for (std::size_t k = 0; k < st.size(); ++k) {
     const int n = std::snprintf(buf, sizeof buf,
@@ -53,13 +55,19 @@ std::string format_particle_state(const ParticleStore& st, const std::string& su
                                 static_cast<unsigned long long>(st.id[k]), st.x[k], st.y[k], st.z[k], st.radius[k],
                                 st.vx[k], st.vy[k], st.vz[k], st.wx[k], st.wy[k], st.wz[k], st.fixed(k) ? 1 : 0);
     s.append(buf, static_cast<std::size_t>(n));
+    if (v2) {  // the material's name replaces the newline's place
+      s.back() = ',';
+      s += materials.at(st.material[k]);
+      s += '\n';
+    }
   }
   return s;
 }
 
 void write_particle_state(const std::filesystem::path& path, const ParticleStore& store,
-                          const std::string& subdomain, double time, double coarse_grain) {
-  write_file_atomically(path, format_particle_state(store, subdomain, time, coarse_grain));
+                          const std::string& subdomain, double time, double coarse_grain,
+                          const std::vector<std::string>& materials) {
+  write_file_atomically(path, format_particle_state(store, subdomain, time, coarse_grain, materials));
 }
 
 std::size_t count_lines(const std::filesystem::path& path) {
@@ -86,15 +94,24 @@ std::size_t for_each_particle_state_row(const std::filesystem::path& path,
   std::size_t rows = 0;
   std::string raw;
   std::size_t line = 0;
-  bool header = false;
+  bool header = false, v2 = false;
   while (std::getline(in, raw)) {
     ++line;
-    const std::string text = trim(raw);
+    std::string text = trim(raw);
     if (text.empty() || text[0] == '#') continue;
     if (!header) {
-      if (text != kHeader) fail(path, line, std::string("expected the header '") + kHeader + "'", text);
+      if (text != kHeader && text != kHeaderV2)
+        fail(path, line, std::string("expected the header '") + kHeader + "' (or '" + kHeaderV2 + "')", text);
       header = true;
+      v2 = text == kHeaderV2;
       continue;
+    }
+    std::string material;
+    if (v2) {  // the last column is a name
+      const std::size_t comma = text.rfind(',');
+      material = comma == std::string::npos ? std::string() : trim(text.substr(comma + 1));
+      if (material.empty()) fail(path, line, "expected a material name in column 13", text);
+      text.resize(comma);
     }
     double v[kColumns];
     int col = 0;
@@ -125,6 +142,7 @@ std::size_t for_each_particle_state_row(const std::filesystem::path& path,
     if (!(p.radius > 0)) fail(path, line, "expected a radius > 0 in column 5", text);
     if (v[11] != 0 && v[11] != 1) fail(path, line, "expected fixed = 0 or 1 in column 12", text);
     p.fixed = v[11] == 1;
+    p.material = std::move(material);
     visit(p);
     ++rows;
   }

@@ -12,7 +12,10 @@
 // particle. Units SI (m, m/s, rad/s); radius is the parcel radius (the
 // subdomain's coarse-grain ratio already applied); fixed is 0 or 1. Numbers
 // are written with 17 significant digits, so a write/read round trip is
-// exact.
+// exact. A subdomain of several materials (a mixture) writes v2: a 13th
+// column "material", the particle's material by name
+// ("id,x,y,z,radius,vx,vy,vz,wx,wy,wz,fixed,material"); a v1 file's
+// particles are of the reading subdomain's own material.
 #pragma once
 
 #include "core/particle_store.hpp"
@@ -30,16 +33,20 @@ struct ParticleStateRow {
   double x = 0, y = 0, z = 0, radius = 0;
   double vx = 0, vy = 0, vz = 0, wx = 0, wy = 0, wz = 0;
   bool fixed = false;
+  std::string material;  ///< v2: the material's name; v1: empty (the subdomain's own)
 };
 
 /// The file's text for the particles of `store` (header comments name the
-/// subdomain, the simulated time and the coarse-grain ratio).
+/// subdomain, the simulated time and the coarse-grain ratio). With more
+/// than one name in `materials` (the names of ParticleStore::material's
+/// indices) the file is v2, with each particle's material.
 std::string format_particle_state(const ParticleStore& store, const std::string& subdomain, double time,
-                                  double coarse_grain);
+                                  double coarse_grain, const std::vector<std::string>& materials = {});
 
 /// Write format_particle_state() to `path`, whole or not at all.
 void write_particle_state(const std::filesystem::path& path, const ParticleStore& store,
-                          const std::string& subdomain, double time, double coarse_grain);
+                          const std::string& subdomain, double time, double coarse_grain,
+                          const std::vector<std::string>& materials = {});
 
 /// Read a state file. Throws std::runtime_error "<file>:<line>: <what was
 /// expected>, found '<text>'" on the first bad line: a missing or different

@@ -22,6 +22,8 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 #include <vtkTypeUInt64Array.h>
 #include <vtkXMLPolyDataWriter.h>
 
@@ -46,7 +48,7 @@ void check_store(const ParticleSet& set) {
                           s.wx.size() == n && s.wy.size() == n && s.wz.size() == n &&
                           s.fx.size() == n && s.fy.size() == n && s.fz.size() == n && s.tx.size() == n &&
                           s.ty.size() == n && s.tz.size() == n && s.radius.size() == n && s.mass.size() == n &&
-                          s.contacts.size() == n;
+                          s.contacts.size() == n && s.material.size() == n;
   if (!consistent) {
     throw RuntimeError("VtkSeriesWriter::write: particle store of subdomain " +
                        std::to_string(set.subdomain) + " has arrays of different lengths");
@@ -134,7 +136,7 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
       mas[k] = s.mass[i];
       ids[k] = s.id[i];
       sub[k] = set.subdomain;
-      mat[k] = set.material;
+      mat[k] = set.materials ? static_cast<int>((*set.materials)[s.material[i]]) : 0;
       // Int32 is what ParaView filters handle best; a count never gets near INT_MAX.
       con[k] = static_cast<int>(std::min<std::uint32_t>(s.contacts[i], INT_MAX));
       conn[k] = static_cast<vtkIdType>(k);
@@ -157,6 +159,14 @@ fs::path VtkSeriesWriter::write(double time, const std::vector<ParticleSet>& set
   pd->AddArray(id);
   pd->AddArray(subdomain);
   pd->AddArray(material);
+  if (!material_names_.empty()) {
+    vtkNew<vtkStringArray> names;
+    names->SetName("material_names");
+    names->SetNumberOfValues(static_cast<vtkIdType>(material_names_.size()));
+    for (std::size_t m = 0; m < material_names_.size(); ++m)
+      names->SetValue(static_cast<vtkIdType>(m), material_names_[m]);
+    poly->GetFieldData()->AddArray(names);
+  }
   pd->AddArray(contacts);
 
   vtkNew<vtkXMLPolyDataWriter> writer;

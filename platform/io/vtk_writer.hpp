@@ -24,7 +24,9 @@ namespace domel::platform::io {
 struct ParticleSet {
   const ParticleStore* store;
   int subdomain;
-  int material = 0;  ///< index into the scenario's materials (one per subdomain)
+  /// the subdomain's materials as indices into the scenario's
+  /// (ParticleStore::material is a position in this list); null: all 0
+  const std::vector<std::size_t>* materials = nullptr;
 };
 
 /// ParaView particle time series: <dir>/<basename>_<000000>.vtp files plus
@@ -55,6 +57,11 @@ class VtkSeriesWriter {
   /// Returns the path of the .vtp written.
   std::filesystem::path write(double time, const std::vector<ParticleSet>& sets);
 
+  /// The scenario's material names by index: written as field data
+  /// "material_names" (a string array) with every frame, so that the
+  /// `material` point array can be read without the scenario.
+  void set_material_names(std::vector<std::string> names) { material_names_ = std::move(names); }
+
   /// Number of .vtp files written so far by this writer.
   std::size_t files_written() const { return frames_.size(); }
   /// Checkpoints: the frames' times, and continuing the series (VtkFrames::resume).
@@ -65,6 +72,7 @@ class VtkSeriesWriter {
   std::filesystem::path directory_;
   std::string basename_;
   VtkFrames frames_;
+  std::vector<std::string> material_names_;
 };
 
 }  // namespace domel::platform::io

@@ -62,7 +62,11 @@ void build_materials(Build& b) {
     // std::minmax returns references: bind the names first (temporaries would dangle)
     const std::string x = it["materials"][0].get<std::string>(), y = it["materials"][1].get<std::string>();
     const std::pair<std::string, std::string> key = std::minmax(x, y);
-    b.coeffs[key] = {it["restitution"].get<double>(), it["friction"].get<double>()};
+    PairCoefficients& c = b.coeffs[key];
+    c.restitution = it["restitution"].get<double>();
+    c.friction = it["friction"].get<double>();
+    c.has_rolling_friction = it.contains("rolling_friction");
+    if (c.has_rolling_friction) c.rolling_friction = it["rolling_friction"].get<double>();
   }
 }
 
@@ -203,7 +207,7 @@ void check_initial_particles(Build& b, const Subdomain& sub, const json& sd, con
 }
 
 /// A subdomain's particles from its initial_state file.
-void build_initial_state(Build& b, Subdomain& sub, const json& sd, const std::string& base, double density) {
+void build_initial_state(Build& b, Subdomain& sub, const json& sd, const std::string& base) {
   if (!sd.contains("initial_state")) return;
   const std::filesystem::path f = scenario_path(b.file, sd["initial_state"].get<std::string>());
   try {
@@ -212,7 +216,10 @@ void build_initial_state(Build& b, Subdomain& sub, const json& sd, const std::st
     // first (an upper bound): no copy of the rows, no doubling slack
     st.reserve(st.size() + io::count_lines(f));
     const std::size_t rows = io::for_each_particle_state_row(f, [&](const io::ParticleStateRow& p) {
-      st.add(b.next_id++, p.x, p.y, p.z, p.radius, density, p.fixed);
+      // a v2 file names each particle's material (registered by build_subdomain(), checked by validation)
+      const std::size_t global = p.material.empty() ? sub.material() : b.mat_index.at(p.material);
+      st.add(b.next_id++, p.x, p.y, p.z, p.radius, b.sim.materials[global].density, p.fixed,
+             sub.local_material(global));
       if (p.fixed) return;  // a fixed particle stays at rest
       st.vx.back() = p.vx; st.vy.back() = p.vy; st.vz.back() = p.vz;
       st.wx.back() = p.wx; st.wy.back() = p.wy; st.wz.back() = p.wz;
@@ -236,15 +243,21 @@ struct Inserter {
   double velocity[3] = {0, 0, 0};
   bool fixed = false;
   std::uint64_t seed = 0;
+  std::uint8_t material = 0;  ///< the particles' material, local to the subdomain
+  double density = 0;         ///< its density [kg/m^3]
 };
 
 /// Throws PluginError when the plugin refuses its parameters. `derived_seed`
 /// is used when the block gives no seed; the instance's messages name `subdomain`.
-Inserter make_inserter(Build& b, const json& block, const std::string& subdomain, std::uint64_t derived_seed) {
+Inserter make_inserter(Build& b, const json& block, Subdomain& sub, std::uint64_t derived_seed) {
   Inserter ins;
   ins.registered = b.registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
   ins.model = std::make_shared<ModelInstance>(*ins.registered, plugin_params(block, DOMEL_KIND_INSERTION),
-                                              "subdomain '" + subdomain + "'");
+                                              "subdomain '" + sub.name() + "'");
+  const std::size_t global = block.contains("material") ? b.mat_index.at(block["material"].get<std::string>())
+                                                        : sub.material();
+  ins.material = sub.local_material(global);  // registered by build_subdomain() already
+  ins.density = b.sim.materials[global].density;
   ins.region = make_region(block["region"]);
   for (int a = 0; a < 3; ++a) ins.velocity[a] = block["velocity"][a].get<double>();
   ins.fixed = block["fixed"].get<bool>();
@@ -263,20 +276,20 @@ std::uint64_t name_hash(const std::string& name) {
 
 /// The start-up insertions, in order, after the initial state (whose
 /// particles they avoid).
-void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::string& base, double density) {
+void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::string& base) {
   if (!sd.contains("insert")) return;
   const std::uint64_t hash = name_hash(sub.name());
   for (std::size_t q = 0; q < sd["insert"].size(); ++q) {
     const json& block = sd["insert"][q];
     const std::string where = idx(base + "/insert", q);
     try {
-      const Inserter ins = make_inserter(b, block, sub.name(), b.sim.seed * 1000003ull + hash + q);
+      const Inserter ins = make_inserter(b, block, sub, b.sim.seed * 1000003ull + hash + q);
       ParticleStore& st = sub.store();
       const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
                                                                b.sim.flow.max_particles);
       st.reserve(st.size() + c.size());
       for (std::size_t p = 0; p < c.size(); ++p) {
-        st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], density, ins.fixed);
+        st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], ins.density, ins.fixed, ins.material);
         st.vx.back() = ins.velocity[0]; st.vy.back() = ins.velocity[1]; st.vz.back() = ins.velocity[2];
       }
       spdlog::info("subdomain '{}': inserted {} particles with '{}' ({})", sub.name(), c.size(), ins.registered->name,
@@ -288,11 +301,19 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
   }
 }
 
+/// Particles a subdomain will get during the run (a pour's, a coupled fine
+/// level's): their size range and material, for its skin and time step.
+struct PourProbe {
+  double r_min, r_max;  ///< [m]
+  double density;       ///< [kg/m^3]
+  std::uint8_t material;
+};
+
 /// The pours: their model instances live for the run; one dry event per pour
 /// (no particle present) gives the radii it will insert, appended to
 /// `pour_radii` for the skin and the time step of a subdomain that starts empty.
-void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& base, double density,
-                 std::vector<double>& pour_radii) {
+void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& base,
+                 std::vector<PourProbe>& pour_radii) {
   if (!sd.contains("pour")) return;
   const std::uint64_t hash = name_hash(sub.name());
   const double* gravity = b.sim.gravity;
@@ -300,7 +321,7 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
     const json& pb = sd["pour"][q];
     const std::string where = idx(base + "/pour", q);
     try {
-      const Inserter ins = make_inserter(b, pb["insert"], sub.name(), b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
+      const Inserter ins = make_inserter(b, pb["insert"], sub, b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
       Pour p;
       p.where = where;
       p.subdomain = b.sim.subdomains.size();
@@ -309,7 +330,8 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
       for (int a = 0; a < 3; ++a) p.velocity[a] = ins.velocity[a];
       p.fixed = ins.fixed;
       p.seed = ins.seed;
-      p.density = density;
+      p.density = ins.density;
+      p.material = ins.material;
       p.alpha = sub.coarse_grain();
       p.mass_rate = pb["mass_rate"].get<double>();
       if (pb.contains("total_mass")) p.total_mass = pb["total_mass"].get<double>();
@@ -338,7 +360,8 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
                  "enlarge the region or raise the model's volume_fraction / count");
         continue;
       }
-      pour_radii.insert(pour_radii.end(), c.r.begin(), c.r.end());
+      pour_radii.push_back({*std::min_element(c.r.begin(), c.r.end()), *std::max_element(c.r.begin(), c.r.end()),
+                            p.density, p.material});
       double one_event = 0;
       for (double rr : c.r) one_event += p.density * 4.0 / 3.0 * M_PI * rr * rr * rr;
       spdlog::info("subdomain '{}': pour {} inserts {:.4g} kg/s with '{}' every {:.4g} s (one full region: {} "
@@ -358,22 +381,29 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
 /// contact/time_step (with a pour's smallest particle present for the
 /// estimate). False when the subdomain cannot run (reported).
 bool set_time_step(Build& b, Subdomain& sub, const json& sd, const std::string& base,
-                   const std::vector<double>& pour_radii, double density, TimeStepReport& rep) {
+                   const std::vector<PourProbe>& pour_radii, TimeStepReport& rep) {
   Checker& ck = b.ck;
   const std::string& sd_name = sub.name();
   const double v_imp = sd["impact_velocity"].get<double>();
-  // a pour's smallest particle, present only for the estimate (the
-  // smallest particle sets the Rayleigh time)
-  const bool probe_particle = !pour_radii.empty();
-  if (probe_particle)
-    sub.store().add(0, 0.0, 0.0, 0.0, *std::min_element(pour_radii.begin(), pour_radii.end()), density);
+  // the smallest particle of each material still to come, present only for
+  // the estimate (the smallest particle sets the Rayleigh time)
+  std::vector<const PourProbe*> smallest(sub.materials().size(), nullptr);
+  for (const PourProbe& p : pour_radii)
+    if (!smallest[p.material] || p.r_min < smallest[p.material]->r_min) smallest[p.material] = &p;
+  std::size_t probes = 0;
+  for (const PourProbe* p : smallest)
+    if (p) {
+      sub.store().add(0, 0.0, 0.0, 0.0, p->r_min, p->density, false, p->material);
+      ++probes;
+    }
+  const bool probe_particle = probes > 0;
   try {
     rep = sub.estimate_time_step(v_imp);
   } catch (const PluginError& e) {
     ck.add(base + "/contact", std::string("the contact model failed while estimating the time step: ") + e.what());
     return false;
   }
-  if (probe_particle) sub.store().swap_remove(sub.store().size() - 1);
+  for (std::size_t k = 0; k < probes; ++k) sub.store().swap_remove(sub.store().size() - 1);
   const json& ts = sd["time_step"];
   const std::optional<double> given = ts.is_number() ? std::optional<double>(ts.get<double>()) : std::nullopt;
   if (const TimeStepProblem p =
@@ -398,23 +428,43 @@ void build_subdomain(Build& b, std::size_t k) {
   const std::string mat_name = sd["material"].get<std::string>();
   const double alpha = sd["coarse_grain"].get<double>();
   const double density = b.sim.materials[b.mat_index.at(mat_name)].density;
+  auto coefficients_of = [](const void* table, std::size_t x, std::size_t y) {
+    const Build& bb = *static_cast<const Build*>(table);
+    const std::string nx = bb.sim.materials[x].name, ny = bb.sim.materials[y].name;  // minmax binds references
+    return bb.coeffs.at(std::minmax(nx, ny));
+  };
 
   json used = json::object();
   auto pipeline = build_contact_pipeline(b, sd, base, used);
   if (!pipeline) return;
   b.sim.models_used[sd_name] = used;
   auto sub = std::make_unique<Subdomain>(sd_name, alpha, b.mat_index.at(mat_name), std::move(pipeline));
-  std::vector<PairCoefficients> wall_coeffs;
-  for (const auto& w : b.sim.walls)
-    wall_coeffs.push_back(b.coeffs.at(std::minmax(mat_name, b.sim.materials[w.material].name)));
-  sub->set_environment(b.sim.materials, wall_coeffs, b.coeffs.at(std::minmax(mat_name, mat_name)), &b.sim.walls,
-                       b.sim.gravity);
+  // its materials: its own, then those of its insertions and pours, in order (a mixture)
+  auto add_material = [&](const json& block) {
+    if (block.contains("material")) sub->local_material(b.mat_index.at(block["material"].get<std::string>()));
+  };
+  if (sd.contains("insert"))
+    for (const auto& block : sd["insert"]) add_material(block);
+  if (sd.contains("pour"))
+    for (const auto& pb : sd["pour"]) add_material(pb["insert"]);
+  if (sd.contains("initial_state")) {  // a mixture's state file (v2) names its materials
+    try {
+      std::set<std::string> names;
+      io::for_each_particle_state_row(scenario_path(b.file, sd["initial_state"].get<std::string>()),
+                                      [&](const io::ParticleStateRow& p) { names.insert(p.material); });
+      for (const auto& n : names)
+        if (!n.empty() && b.mat_index.count(n)) sub->local_material(b.mat_index.at(n));
+    } catch (const std::exception&) {
+      // reported with its line by validation and build_initial_state()
+    }
+  }
+  sub->set_environment(b.sim.materials, &b, coefficients_of, &b.sim.walls, b.sim.gravity);
 
   const std::size_t problems_before_insert = b.ck.diags.size();
-  build_initial_state(b, *sub, sd, base, density);
-  build_insertions(b, *sub, sd, base, density);
-  std::vector<double> pour_radii;
-  build_pours(b, *sub, sd, base, density, pour_radii);
+  build_initial_state(b, *sub, sd, base);
+  build_insertions(b, *sub, sd, base);
+  std::vector<PourProbe> pour_radii;
+  build_pours(b, *sub, sd, base, pour_radii);
   if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
   check_initial_particles(b, *sub, sd, base);
   // The fine level of a coupling starts empty: its particles will be its
@@ -434,25 +484,25 @@ void build_subdomain(Build& b, std::size_t k) {
     double alpha_c = 1;
     for (const auto& other : b.doc["subdomains"])
       if (other["name"] == it->second.first) alpha_c = other["coarse_grain"].get<double>();
-    for (double r : pr->second)
-      if (r > 0) pour_radii.push_back(r * alpha / alpha_c);
+    if (pr->second[0] > 0)
+      pour_radii.push_back({pr->second[0] * alpha / alpha_c, pr->second[1] * alpha / alpha_c, density, 0});
   }
 
   // neighbour skin: fraction of the largest diameter
   double rmax = 0;
   for (double r : sub->store().radius) rmax = std::max(rmax, r);
-  for (double r : pour_radii) rmax = std::max(rmax, r);
+  for (const PourProbe& p : pour_radii) rmax = std::max(rmax, p.r_max);
   sub->set_skin(sd["skin"].get<double>() * 2.0 * (rmax > 0 ? rmax : 1e-3));
   {
     double rmin = rmax;
     for (double r : sub->store().radius) rmin = std::min(rmin, r);
-    for (double r : pour_radii) rmin = std::min(rmin, r);
+    for (const PourProbe& p : pour_radii) rmin = std::min(rmin, p.r_min);
     b.radii[sd_name] = {rmin, rmax};
   }
   sub->set_reorder_every(sd["reorder_every"].get<std::size_t>());
 
   TimeStepReport rep;
-  if (!set_time_step(b, *sub, sd, base, pour_radii, density, rep)) return;
+  if (!set_time_step(b, *sub, sd, base, pour_radii, rep)) return;
   b.sim.time_steps.push_back(rep);
   b.sim.subdomains.push_back(std::move(sub));
 }
@@ -705,6 +755,72 @@ bool walls_and_regions_bounds(Build& b, double lo[3], double hi[3], bool all) {
   return any;
 }
 
+/// Subdomains never touch each other's particles: two that share space
+/// without a coupling between them (directly or through other levels) are
+/// most likely a mixture written as two subdomains, whose particles pass
+/// through each other. Warned, not refused: overlaid independent runs (a
+/// parameter study in one file) are legitimate.
+void warn_shared_space(Build& b) {
+  const auto& sds = b.sim.subdomains;
+  const std::size_t n = sds.size();
+  // coupled families (union-find over the couplings' levels)
+  std::vector<std::size_t> root(n);
+  for (std::size_t k = 0; k < n; ++k) root[k] = k;
+  auto find = [&](std::size_t k) {
+    while (root[k] != k) k = root[k] = root[root[k]];
+    return k;
+  };
+  auto index_of = [&](const json& name) {
+    for (std::size_t k = 0; k < n; ++k)
+      if (sds[k]->name() == name.get<std::string>()) return k;
+    return n;
+  };
+  if (b.doc.contains("couplings"))
+    for (const auto& c : b.doc["couplings"]) {
+      const std::size_t x = index_of(c["coarse"]), y = index_of(c["fine"]);
+      if (x < n && y < n) root[find(x)] = find(y);
+    }
+  // each subdomain's box: its particles at the start and its pour regions
+  std::vector<std::array<double, 6>> box(n);
+  std::vector<bool> any(n, false);
+  auto grow = [&](std::size_t k, const double lo[3], const double hi[3]) {
+    for (int a = 0; a < 3; ++a) {
+      box[k][a] = any[k] ? std::min(box[k][a], lo[a]) : lo[a];
+      box[k][3 + a] = any[k] ? std::max(box[k][3 + a], hi[a]) : hi[a];
+    }
+    any[k] = true;
+  };
+  for (std::size_t k = 0; k < n; ++k) {
+    const ParticleStore& s = sds[k]->store();
+    for (std::size_t q = 0; q < s.size(); ++q) {
+      const double lo[3] = {s.x[q] - s.radius[q], s.y[q] - s.radius[q], s.z[q] - s.radius[q]};
+      const double hi[3] = {s.x[q] + s.radius[q], s.y[q] + s.radius[q], s.z[q] + s.radius[q]};
+      grow(k, lo, hi);
+    }
+  }
+  for (const auto& p : b.sim.flow.pours) {
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      const bool along = p.region.shape == 1 || a == static_cast<int>(p.region.axis);
+      lo[a] = along ? p.region.lo[a] : p.region.center[a] - p.region.radius;
+      hi[a] = along ? p.region.hi[a] : p.region.center[a] + p.region.radius;
+    }
+    if (p.subdomain < n) grow(p.subdomain, lo, hi);
+  }
+  for (std::size_t x = 0; x < n; ++x)
+    for (std::size_t y = x + 1; y < n; ++y) {
+      if (!any[x] || !any[y] || find(x) == find(y)) continue;
+      bool overlap = true;
+      for (int a = 0; a < 3; ++a)
+        overlap = overlap && box[x][a] < box[y][3 + a] && box[y][a] < box[x][3 + a];
+      if (overlap)
+        spdlog::warn("subdomains '{}' and '{}' share space but no coupling joins them: subdomains never touch, so "
+                     "their particles pass through each other; for a mixture use several materials in one subdomain "
+                     "(an insertion's \"material\", docs/getting-started.md, \"Mixtures\")",
+                     sds[x]->name(), sds[y]->name());
+    }
+}
+
 /// The scene's box for drawing walls (output.wall_surfaces): the walls, the
 /// regions and the particles at the start, padded by 5 % of its diagonal (a
 /// plane alone: 1 m about its point).
@@ -764,6 +880,17 @@ void build_couplings(Build& b) {
                "a coupling joins a coarse subdomain and a finer one");
       continue;
     }
+    // the coupling inserts, counts and controls one material: a mixture's levels are not coupled (yet)
+    bool mixture = false;
+    for (std::size_t k : {s.coarse, s.fine})
+      if (sim.subdomains[k]->materials().size() > 1) {
+        b.ck.add(base + (k == s.coarse ? "/coarse" : "/fine"),
+                 "subdomain '" + names[k] + "' holds several materials (a mixture); a coupling joins levels of "
+                 "one material each",
+                 "couple levels of one material, or run the mixture in one subdomain without a coupling");
+        mixture = true;
+      }
+    if (mixture) continue;
     Subdomain& coarse = *sim.subdomains[s.coarse];
     Subdomain& fine = *sim.subdomains[s.fine];
     if (fine.coarse_grain() >= coarse.coarse_grain()) {
@@ -1236,6 +1363,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   for (std::size_t k = 0; k < doc["subdomains"].size(); ++k) build_subdomain(b, k);
   if (b.sim.subdomains.size() == doc["subdomains"].size()) build_couplings(b);
   build_particle_flow(b);
+  if (b.ck.diags.empty()) warn_shared_space(b);
   build_grids(b);
   build_repose_probe(b);
   build_contact_outputs(b);

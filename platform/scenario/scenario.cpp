@@ -373,7 +373,8 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
 
   // subdomains
   std::set<std::string> sd_names;
-  std::vector<std::pair<std::string, std::string>> sd_materials;  // (subdomain, material)
+  // (subdomain, its materials: its own first, then those its insertions and pours name)
+  std::vector<std::pair<std::string, std::vector<std::string>>> sd_materials;
   if (const json* sds = member(doc, "subdomains"); sds && sds->is_array()) {
     for (std::size_t k = 0; k < sds->size(); ++k) {
       const json& sd = (*sds)[k];
@@ -387,13 +388,46 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
           ck.add("/materials/" + escape_pointer_token(mat), "missing required property 'density'",
                  "subdomain '" + (name && name->is_string() ? name->get<std::string>() : std::to_string(k)) +
                      "' makes particles of this material");
-        sd_materials.emplace_back(name && name->is_string() ? name->get<std::string>() : std::to_string(k), mat);
+        sd_materials.emplace_back(name && name->is_string() ? name->get<std::string>() : std::to_string(k),
+                                  std::vector<std::string>{mat});
+        // the materials of its insertions and pours (a mixture)
+        auto insert_material = [&](const json& block, const std::string& pointer) {
+          const std::string m = check_material(member(block, "material"), pointer + "/material");
+          if (m.empty()) return;
+          if (!has_density[m])
+            ck.add("/materials/" + escape_pointer_token(m), "missing required property 'density'",
+                   pointer + " makes particles of this material");
+          auto& list = sd_materials.back().second;
+          if (std::find(list.begin(), list.end(), m) == list.end()) list.push_back(m);
+        };
+        if (const json* ins = member(sd, "insert"); ins && ins->is_array())
+          for (std::size_t q = 0; q < ins->size(); ++q) insert_material((*ins)[q], idx(base + "/insert", q));
+        if (const json* pours = member(sd, "pour"); pours && pours->is_array())
+          for (std::size_t q = 0; q < pours->size(); ++q)
+            if (const json* ins = member((*pours)[q], "insert"))
+              insert_material(*ins, idx(base + "/pour", q) + "/insert");
       }
       if (const json* st = member(sd, "initial_state"); st && st->is_string() && !st->get<std::string>().empty()) {
         const std::filesystem::path f = scenario_path(ck.file, st->get<std::string>());
         try {
-          if (io::for_each_particle_state_row(f, [](const io::ParticleStateRow&) {}) == 0)
+          std::set<std::string> names;  // a mixture's (v2) materials
+          if (io::for_each_particle_state_row(f, [&](const io::ParticleStateRow& p) { names.insert(p.material); }) == 0)
             ck.add(base + "/initial_state", "expected at least one particle in " + f.string() + ", found none");
+          for (const auto& n : names) {
+            if (n.empty()) continue;
+            if (std::find(materials.begin(), materials.end(), n) == materials.end()) {
+              ck.add(base + "/initial_state", "the state file " + f.string() + " holds particles of material '" + n +
+                                                  "', which is not in /materials", suggest(n, materials));
+              continue;
+            }
+            if (!has_density[n])
+              ck.add("/materials/" + escape_pointer_token(n), "missing required property 'density'",
+                     base + "/initial_state makes particles of this material");
+            if (!mat.empty()) {  // this subdomain's list is the last one
+              auto& list = sd_materials.back().second;
+              if (std::find(list.begin(), list.end(), n) == list.end()) list.push_back(n);
+            }
+          }
         } catch (const std::exception& e) {
           ck.add(base + "/initial_state", e.what(),
                  std::filesystem::exists(f) ? "write it with output.state: true in an earlier run"
@@ -460,10 +494,15 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
            "add {\"materials\": [\"" + a + "\", \"" + b + "\"], \"restitution\": ..., \"friction\": ...}");
     pairs.insert(std::minmax(a, b));  // report each missing pair once
   };
-  for (const auto& [sd, mat] : sd_materials) {
-    need(mat, mat, "subdomain '" + sd + "'");
-    for (const auto& [wall, wmat] : wall_materials) need(mat, wmat, "subdomain '" + sd + "' touching wall '" + wall + "'");
-  }
+  for (const auto& [sd, mats] : sd_materials)
+    for (std::size_t a = 0; a < mats.size(); ++a) {
+      for (std::size_t b = a; b < mats.size(); ++b)
+        need(mats[a], mats[b],
+             mats.size() == 1 ? "subdomain '" + sd + "'"
+                              : "subdomain '" + sd + "', whose particles of " + mats[a] + " touch those of " + mats[b]);
+      for (const auto& [wall, wmat] : wall_materials)
+        need(mats[a], wmat, "subdomain '" + sd + "' touching wall '" + wall + "'");
+    }
 }
 
 /// The passes, in order; fills the schema defaults into `doc` on the way

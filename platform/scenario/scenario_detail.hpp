@@ -78,7 +78,7 @@ inline int axis_index(const json* j) {
 
 /// Platform keys of a model block that are not the plugin's parameters.
 inline std::vector<std::string> platform_keys(uint32_t kind) {
-  if (kind == DOMEL_KIND_INSERTION) return {"model", "region", "seed", "velocity", "fixed"};
+  if (kind == DOMEL_KIND_INSERTION) return {"model", "region", "seed", "velocity", "fixed", "material"};
   if (kind == DOMEL_KIND_FLUID_COUPLER) return {"model", "subdomains", "interval", "write_interval"};
   return {"model"};
 }

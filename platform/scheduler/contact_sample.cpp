@@ -40,8 +40,6 @@ void ContactSample::begin(double t) {
 void ContactSample::take(std::size_t k, const Subdomain& sd, const std::vector<WallPrimitive>& walls) {
   const ParticleStore& s = sd.store();
   const auto records = sd.contact_records();
-  const double mu_pair = sd.self_pair().friction;
-  const std::vector<domel_pair_v2>& wall_pairs = sd.wall_pairs();
   for (const auto* list : records)
     for (const ContactRecord& c : *list) {
       const bool wall = c.j == ContactRecord::kWall;
@@ -81,7 +79,8 @@ void ContactSample::take(std::size_t k, const Subdomain& sd, const std::vector<W
       row.id_j = wall ? io::ContactRow::kWallId : s.id[c.j];
       row.subdomain = static_cast<std::int32_t>(k);
       row.wall = wall ? static_cast<std::int32_t>(walls[c.wall].wall) : -1;
-      const double mu = wall ? wall_pairs[c.wall].friction : mu_pair;
+      const double mu = wall ? sd.wall_pair(c.wall, s.material[c.i]).friction
+                             : sd.pair(s.material[c.i], s.material[c.j]).friction;
       const double ft = std::sqrt(row.tangential[0] * row.tangential[0] + row.tangential[1] * row.tangential[1] +
                                   row.tangential[2] * row.tangential[2]);
       row.sliding = ft > 0 && ft >= mu * std::fabs(fn) * (1.0 - kSlidingTolerance) ? 1 : 0;

@@ -122,7 +122,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   std::size_t taken = 0;
   for (std::size_t q = 0; q < c.size() && p.inserted_mass < target; ++q) {
     const std::uint64_t id = next_id++;
-    st.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.density, p.fixed);
+    st.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.density, p.fixed, p.material);
     const std::size_t k = st.size() - 1;
     st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
     p.inserted_mass += st.mass[k];

@@ -79,6 +79,7 @@ struct Pour {
   double velocity[3] = {0, 0, 0};
   bool fixed = false;
   double density = 0;
+  std::uint8_t material = 0;  ///< the particles' material, local to the subdomain
   double alpha = 1;
   double mass_rate = 0;     ///< [kg/s]
   double total_mass = std::numeric_limits<double>::infinity();  ///< [kg]

@@ -287,7 +287,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   std::unique_ptr<io::CsvSeries> probes;
   if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
   std::unique_ptr<io::VtkSeriesWriter> vtk;
-  if (vtk_interval > 0) vtk = std::make_unique<io::VtkSeriesWriter>(out, "particles");
+  if (vtk_interval > 0) {
+    vtk = std::make_unique<io::VtkSeriesWriter>(out, "particles");
+    std::vector<std::string> names;
+    for (const Material& m : materials) names.push_back(m.name);
+    vtk->set_material_names(std::move(names));
+  }
   std::unique_ptr<io::WallSurfaceSeries> wall_vtk;
   if (vtk && wall_surfaces && !walls.empty()) wall_vtk = std::make_unique<io::WallSurfaceSeries>(out, "walls");
   std::unique_ptr<io::ContactSeriesWriter> contact_vtk;
@@ -315,7 +320,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   auto write_vtk = [&](double t) {
     std::vector<io::ParticleSet> sets;
     for (std::size_t k = 0; k < subdomains.size(); ++k)
-      sets.push_back({&subdomains[k]->store(), static_cast<int>(k), static_cast<int>(subdomains[k]->material())});
+      sets.push_back({&subdomains[k]->store(), static_cast<int>(k), &subdomains[k]->materials()});
     vtk->write(t, sets);
     if (wall_vtk) wall_vtk->write(t, walls, scene_lo, scene_hi);
     if (probes) probes->flush();  // probes.csv reaches the frame just written
@@ -623,7 +628,9 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       std::string f = sd->name() + "_state.csv";
       for (char& c : f)  // a file name whatever the subdomain is called
         if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '_';
-      io::write_particle_state(out / f, sd->store(), sd->name(), result.simulated_time, sd->coarse_grain());
+      std::vector<std::string> names;  // of its materials, by local index
+      for (std::size_t g : sd->materials()) names.push_back(materials[g].name);
+      io::write_particle_state(out / f, sd->store(), sd->name(), result.simulated_time, sd->coarse_grain(), names);
       files["state"][sd->name()] = f;
     }
   }

@@ -17,8 +17,19 @@ namespace domel::platform {
 
 Subdomain::Subdomain(std::string name, double coarse_grain, std::size_t material,
                      std::unique_ptr<ContactPipeline> pipeline)
-    : name_(std::move(name)), coarse_grain_(coarse_grain), material_(material), pipeline_(std::move(pipeline)) {
+    : name_(std::move(name)), coarse_grain_(coarse_grain), material_(material), materials_{material},
+      pipeline_(std::move(pipeline)) {
   set_threads(default_thread_count());
+}
+
+std::uint8_t Subdomain::local_material(std::size_t global) {
+  for (std::size_t k = 0; k < materials_.size(); ++k)
+    if (materials_[k] == global) return static_cast<std::uint8_t>(k);
+  if (materials_.size() == ParticleStore::kMaxMaterials)
+    throw std::length_error("subdomain '" + name_ + "': more than " + std::to_string(ParticleStore::kMaxMaterials) +
+                            " materials");
+  materials_.push_back(global);
+  return static_cast<std::uint8_t>(materials_.size() - 1);
 }
 
 void Subdomain::set_threads(int threads) {
@@ -29,16 +40,25 @@ void Subdomain::set_threads(int threads) {
   partition_.set_threads(pool_->size());
 }
 
-void Subdomain::set_environment(const std::vector<Material>& materials,
-                                const std::vector<PairCoefficients>& wall_pairs, const PairCoefficients& self_pair,
-                                const std::vector<WallPrimitive>* walls, const double gravity[3]) {
-  own_material_ = materials.at(material_);
+void Subdomain::set_environment(const std::vector<Material>& materials, const void* table,
+                                CoefficientsOf coefficients, const std::vector<WallPrimitive>* walls,
+                                const double gravity[3]) {
   walls_ = walls;
-  self_pair_ = make_pair(own_material_, own_material_, self_pair, false, coarse_grain_);
-  wall_pairs_.clear();
-  for (std::size_t w = 0; w < walls->size(); ++w)
-    wall_pairs_.push_back(make_pair(own_material_, materials.at((*walls)[w].material), wall_pairs.at(w), true,
-                                    coarse_grain_));
+  const std::size_t n = materials_.size();
+  local_materials_.clear();
+  for (std::size_t g : materials_) local_materials_.push_back(materials.at(g));
+  pairs_.assign(n * n, domel_pair_v2{});
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b)
+      pairs_[a * n + b] = make_pair(local_materials_[a], local_materials_[b],
+                                    coefficients(table, materials_[a], materials_[b]), false, coarse_grain_);
+  wall_pairs_.assign(walls->size() * n, domel_pair_v2{});
+  for (std::size_t w = 0; w < walls->size(); ++w) {
+    const std::size_t wm = (*walls)[w].material;
+    for (std::size_t a = 0; a < n; ++a)
+      wall_pairs_[w * n + a] = make_pair(local_materials_[a], materials.at(wm), coefficients(table, materials_[a], wm),
+                                         true, coarse_grain_);
+  }
   wall_lists_.assign(walls->size(), WallNeighbors{});
   walls_now_ = *walls;
   for (int a = 0; a < 3; ++a) body_forces_.gravity[a] = gravity[a];
@@ -46,7 +66,7 @@ void Subdomain::set_environment(const std::vector<Material>& materials,
 
 TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
   synchronize();
-  return platform::estimate_time_step({pipeline_.get(), &own_material_, &self_pair_, &wall_pairs_, walls_}, store_,
+  return platform::estimate_time_step({pipeline_.get(), &local_materials_, &pairs_, &wall_pairs_, &walls_now_}, store_,
                                       impact_velocity);
 }
 
@@ -358,11 +378,13 @@ void Subdomain::step_in_order() {
 }
 
 PairSweep Subdomain::pair_sweep() const {
-  return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), &self_pair_, dt_, record_};
+  return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), pairs_.data(),
+          static_cast<uint32_t>(materials_.size()), dt_, record_};
 }
 
 WallSweep Subdomain::wall_sweep() {
-  return {&store_, &wall_lists_, &walls_now_, &wall_pairs_, pipeline_.get(), dt_, forces_time_, wall_time_, record_};
+  return {&store_, &wall_lists_, &walls_now_, wall_pairs_.data(), static_cast<uint32_t>(materials_.size()),
+          pipeline_.get(), dt_, forces_time_, wall_time_, record_};
 }
 
 void Subdomain::contact_forces(bool defer_reduce) {
@@ -394,7 +416,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
     ts.pair_max_ratio = 0.0;
   }
   if (nt == 1) {
-    const PairRangeFn range = pair_kernel(*pipeline_, false);
+    const PairRangeFn range = pair_kernel(*pipeline_, false, materials_.size() > 1);
     range(sweep, 0, nlist_.near_size(), scratch_[0], 0, s.size(), direct, direct);
     if (far) range(sweep, nlist_.near_size(), nlist_.size(), scratch_[0], 0, s.size(), direct, direct);
   } else {
@@ -411,7 +433,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
       const ForceAccumulator shared = t > 0 ? partition_.private_accumulator(t, n) : direct;
       const ForcePartition::ThreadForces& tf = partition_.thread(t);
       // thread 0 adds all its forces into the store
-      const PairRangeFn range = pair_kernel(*pipeline_, t > 0);
+      const PairRangeFn range = pair_kernel(*pipeline_, t > 0, materials_.size() > 1);
       const auto [near_first, near_last] = partition_.entries(0, t);
       range(sweep, near_first, near_last, ts, tf.own_lo, tf.own_hi, direct, shared);
       if (far) {

@@ -44,7 +44,14 @@ class Subdomain {
 
   const std::string& name() const { return name_; }
   double coarse_grain() const { return coarse_grain_; }
+  /// Its own material (index into the scenario's materials): the first of materials().
   std::size_t material() const { return material_; }
+  /// The materials its particles may have, as indices into the scenario's
+  /// materials; ParticleStore::material holds a position in this list.
+  const std::vector<std::size_t>& materials() const { return materials_; }
+  /// The position of scenario material `global` in materials(); adds it
+  /// when absent (before set_environment() only).
+  std::uint8_t local_material(std::size_t global);
   ContactPipeline& pipeline() { return *pipeline_; }
   /// The particles at the end of the last step: a step left pending by
   /// step_deferred() is finished first (synchronize()). The const overload
@@ -60,10 +67,14 @@ class Subdomain {
   /// particle became non-finite. Cheap when nothing is pending.
   void synchronize();
 
-  /// Wire materials and walls (pairs are derived once). Call before setup().
-  void set_environment(const std::vector<Material>& materials, const std::vector<PairCoefficients>& wall_pairs,
-                       const PairCoefficients& self_pair, const std::vector<WallPrimitive>* walls,
-                       const double gravity[3]);
+  /// The coefficients of a pair of scenario materials (the interaction table).
+  using CoefficientsOf = PairCoefficients (*)(const void* table, std::size_t a, std::size_t b);
+  /// Wire materials and walls: every pair of materials() and every (wall,
+  /// material) pair is derived once from the scenario's materials and the
+  /// interaction table `coefficients(table, a, b)`. Call before setup(), after
+  /// every local_material().
+  void set_environment(const std::vector<Material>& materials, const void* table, CoefficientsOf coefficients,
+                       const std::vector<WallPrimitive>* walls, const double gravity[3]);
   /// Where the initial particles came from (a state file), for the message
   /// when their initial forces are not finite (setup()).
   void set_initial_source(std::string source) { initial_source_ = std::move(source); }
@@ -80,10 +91,11 @@ class Subdomain {
   int threads() const { return pool_->size(); }
   double time_step() const { return dt_; }
 
-  /// The pair coefficients of its particle pairs and of each wall primitive
-  /// (friction, restitution, E*, G*), as its contact kernels see them.
-  const domel_pair_v2& self_pair() const { return self_pair_; }
-  const std::vector<domel_pair_v2>& wall_pairs() const { return wall_pairs_; }
+  /// The pair constants (E*, G*, restitution, friction, rolling friction)
+  /// the contact kernels see: of particles of local materials a and b, and
+  /// of a particle of local material a with wall primitive w.
+  const domel_pair_v2& pair(std::size_t a, std::size_t b) const { return pairs_[a * materials_.size() + b]; }
+  const domel_pair_v2& wall_pair(std::size_t w, std::size_t a) const { return wall_pairs_[w * materials_.size() + a]; }
 
   /// The body-force list (gravity; the store's external forces once enabled).
   const BodyForces& body_forces() const { return body_forces_; }
@@ -193,9 +205,10 @@ class Subdomain {
   const std::vector<WallPrimitive>* walls_ = nullptr;  ///< reference state (time 0) of the walls
   std::vector<WallPrimitive> walls_now_;  ///< this subdomain's walls placed at wall_time_
   double wall_time_ = 0;                  ///< time of the walls' placement and surface velocities
-  std::vector<domel_pair_v2> wall_pairs_;
-  domel_pair_v2 self_pair_{};
-  Material own_material_;
+  std::vector<std::size_t> materials_;     ///< scenario indices; [0] = material_
+  std::vector<Material> local_materials_;  ///< their constants, same order
+  std::vector<domel_pair_v2> pairs_;       ///< [a * n + b], n = materials_.size()
+  std::vector<domel_pair_v2> wall_pairs_;  ///< [w * n + a]
   BodyForces body_forces_;
   StepHooks hooks_;
   double skin_ = 0;

@@ -196,6 +196,36 @@ TEST_F(Cli, AScenarioInMillimetresAndAnEmptySubdomainAreWarnedAbout) {
             std::string::npos) << show(r);
 }
 
+TEST_F(Cli, TwoSubdomainsSharingSpaceWithoutACouplingAreWarnedAboutAndAMixtureIsNot) {
+  // a "mixture" written as two subdomains in one box: their particles would
+  // pass through each other (issue 18 item 3)
+  json doc = json::parse(read_file(kSettle));
+  doc["subdomains"].push_back(doc["subdomains"][0]);
+  doc["subdomains"][1]["name"] = "second";
+  const fs::path f = tmp_ / "two.json";
+  std::ofstream(f) << doc.dump(1);
+  const Result r = domel({"validate", f.string()});
+  EXPECT_EQ(r.exit_code, 0) << show(r);
+  EXPECT_NE(r.err.find("subdomains 'column' and 'second' share space but no coupling joins them: subdomains never "
+                       "touch"), std::string::npos) << show(r);
+  EXPECT_NE(r.err.find("for a mixture use several materials in one subdomain"), std::string::npos) << show(r);
+  // the same two sizes as one subdomain of two materials: no warning
+  json mix = json::parse(read_file(kSettle));
+  mix["materials"]["steel"] = {{"density", 7800}, {"youngs_modulus", 2e7}, {"poisson_ratio", 0.3}};
+  mix["interactions"].push_back({{"materials", {"beads", "steel"}}, {"restitution", 0.5}, {"friction", 0.5}});
+  mix["interactions"].push_back({{"materials", {"steel", "steel"}}, {"restitution", 0.5}, {"friction", 0.5}});
+  auto& ins = mix["subdomains"][0]["insert"];
+  ins.push_back(ins[0]);
+  ins[0]["region"]["box"]["max"][2] = 0.02856;
+  ins[1]["region"]["box"]["min"][2] = 0.02856;
+  ins[1]["material"] = "steel";
+  const fs::path g = tmp_ / "mix.json";
+  std::ofstream(g) << mix.dump(1);
+  const Result m = domel({"validate", g.string()});
+  EXPECT_EQ(m.exit_code, 0) << show(m);
+  EXPECT_EQ(m.err.find("share space"), std::string::npos) << show(m);
+}
+
 // ---- hostile files (issue 17, item 6; docs/reliability.md) ----------------------
 
 // Shapes a fuzzer's short inputs miss, generated here: each is refused with

@@ -19,6 +19,8 @@
 #include <unistd.h>
 
 #include <vtkCellArray.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 #include <vtkCellType.h>
 #include <vtkDataArray.h>
 #include <vtkNew.h>
@@ -100,10 +102,12 @@ ParticleStore make_store(std::size_t n, double base, std::uint64_t first_id) {
     s.x.push_back(b + 0.1); s.y.push_back(b + 0.2); s.z.push_back(b + 0.3);
     s.vx.push_back(b + 1.1); s.vy.push_back(b + 1.2); s.vz.push_back(b + 1.3);
     s.wx.push_back(b + 2.1); s.wy.push_back(b + 2.2); s.wz.push_back(b + 2.3);
-    for (auto* v : {&s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz}) v->push_back(0.0);
+    s.fx.push_back(b + 3.1); s.fy.push_back(b + 3.2); s.fz.push_back(b + 3.3);
+    s.tx.push_back(b + 4.1); s.ty.push_back(b + 4.2); s.tz.push_back(b + 4.3);
     s.radius.push_back(0.001 * (b + 1.0));
-    s.mass.push_back(1.0); s.inv_mass.push_back(1.0); s.inv_inertia.push_back(1.0);
+    s.mass.push_back(b + 5.0); s.inv_mass.push_back(1.0); s.inv_inertia.push_back(1.0);
     s.contacts.push_back(static_cast<std::uint32_t>(i + 3));
+    s.material.push_back(static_cast<std::uint8_t>(i % 2));
   }
   return s;
 }
@@ -163,10 +167,12 @@ TEST(IoVtkSeriesWriter, WritesFramesAndCollection) {
   const fs::path out = dir.path() / "vtk";  // created by the writer
 
   VtkSeriesWriter writer(out, "particles");
+  writer.set_material_names({"a", "b", "c", "d", "e", "steel"});
   EXPECT_EQ(writer.files_written(), 0u);
-  const fs::path first = writer.write(0.0, {{&a, 0}, {&b, 3}});
+  const std::vector<std::size_t> b_materials = {2, 5};  // b's local materials 0, 1 are the scenario's 2, 5
+  const fs::path first = writer.write(0.0, {{&a, 0}, {&b, 3, &b_materials}});
   b.vx[1] = -42.0;
-  const fs::path second = writer.write(0.5, {{&a, 0}, {&b, 3}});
+  const fs::path second = writer.write(0.5, {{&a, 0}, {&b, 3, &b_materials}});
   EXPECT_EQ(writer.files_written(), 2u);
   EXPECT_EQ(first, out / "particles_000000.vtp");
   EXPECT_EQ(second, out / "particles_000001.vtp");
@@ -203,9 +209,9 @@ TEST(IoVtkSeriesWriter, WritesFramesAndCollection) {
     const char* name;
     int components;
   };
-  for (const Expected& e : {Expected{"velocity", 3}, Expected{"angular_velocity", 3},
-                            Expected{"radius", 1}, Expected{"id", 1},
-                            Expected{"subdomain", 1}, Expected{"contacts", 1}}) {
+  for (const Expected& e : {Expected{"velocity", 3}, Expected{"angular_velocity", 3}, Expected{"force", 3},
+                            Expected{"torque", 3}, Expected{"radius", 1}, Expected{"mass", 1}, Expected{"id", 1},
+                            Expected{"subdomain", 1}, Expected{"material", 1}, Expected{"contacts", 1}}) {
     vtkAbstractArray* arr = pd->GetAbstractArray(e.name);
     ASSERT_NE(arr, nullptr) << e.name;
     EXPECT_EQ(arr->GetNumberOfComponents(), e.components) << e.name;
@@ -231,6 +237,19 @@ TEST(IoVtkSeriesWriter, WritesFramesAndCollection) {
   EXPECT_EQ(pd->GetArray("subdomain")->GetTuple1(4), 3.0);
   EXPECT_EQ(pd->GetArray("subdomain")->GetTuple1(2), 0.0);
   EXPECT_EQ(pd->GetArray("contacts")->GetTuple1(4), static_cast<double>(b.contacts[1]));
+  pd->GetArray("force")->GetTuple(4, v);
+  EXPECT_EQ(v[0], b.fx[1]);
+  EXPECT_EQ(v[2], b.fz[1]);
+  pd->GetArray("torque")->GetTuple(4, v);
+  EXPECT_EQ(v[1], b.ty[1]);
+  EXPECT_EQ(pd->GetArray("mass")->GetTuple1(4), b.mass[1]);
+  EXPECT_EQ(pd->GetArray("material")->GetTuple1(4), 5.0);  // b[1]: local 1, the scenario's 5
+  EXPECT_EQ(pd->GetArray("material")->GetTuple1(3), 2.0);
+  EXPECT_EQ(pd->GetArray("material")->GetTuple1(1), 0.0);  // a set without materials: 0
+  auto* names = vtkStringArray::SafeDownCast(poly->GetFieldData()->GetAbstractArray("material_names"));
+  ASSERT_NE(names, nullptr);
+  ASSERT_EQ(names->GetNumberOfValues(), 6);
+  EXPECT_EQ(names->GetValue(5), "steel");
 
   // The first frame still holds the old velocity.
   vtkNew<vtkXMLPolyDataReader> reader0;

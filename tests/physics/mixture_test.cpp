@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: MIT
+// Guards several materials in one subdomain (issue 18 item 1): each contact
+// takes the constants of its own pair of materials (restitution, friction,
+// E*), a wall contact those of the wall's material with the particle's, the
+// masses follow each material's density, and the automatic time step is set
+// by the most restrictive pair.
+#include "support/fixture.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <cmath>
+#include <filesystem>
+#include <unistd.h>
+
+namespace dt = domel::test;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kD = 0.0028, kR = kD / 2;
+
+/// Materials a (glass-like beads), b (denser, stiffer) and the wall's w; the
+/// interactions give each pair its own restitution and friction.
+json mixture_doc(double dt) {
+  json doc = dt::scenario(dt::hertz_mindlin(), dt, 0.9, 0.5);
+  doc["materials"] = {{"a", {{"density", 2500}, {"youngs_modulus", 5e6}, {"poisson_ratio", 0.3}}},
+                      {"b", {{"density", 7800}, {"youngs_modulus", 2e7}, {"poisson_ratio", 0.25}}},
+                      {"w", {{"youngs_modulus", 1e7}, {"poisson_ratio", 0.3}}}};
+  doc["interactions"] = {{{"materials", {"a", "a"}}, {"restitution", 0.9}, {"friction", 0.5}},
+                         {{"materials", {"b", "b"}}, {"restitution", 0.3}, {"friction", 0.5}},
+                         {{"materials", {"a", "b"}}, {"restitution", 0.6}, {"friction", 0.4}},
+                         {{"materials", {"a", "w"}}, {"restitution", 0.5}, {"friction", 0.2}},
+                         {{"materials", {"b", "w"}}, {"restitution", 0.5}, {"friction", 0.6}}};
+  doc["subdomains"][0]["material"] = "a";
+  return doc;
+}
+
+/// One sphere of `material` at `x` (a lattice of one site), moving at `v`.
+json one_sphere(const std::string& material, const std::array<double, 3>& x, const std::array<double, 3>& v) {
+  return {{"model", "lattice"}, {"diameter", kD}, {"material", material}, {"velocity", v},
+          {"region", {{"box", {{"min", {x[0] - kR, x[1] - kR, x[2] - kR}}, {"max", {x[0] + kR, x[1] + kR, x[2] + kR}}}}}}};
+}
+
+}  // namespace
+
+TEST(Mixture, APairOfDifferentMaterialsRebouncesWithItsOwnRestitutionAndConservesMomentum) {
+  // A sphere of a meets one of b head-on; the pair's restitution is 0.6 (a-a
+  // 0.9, b-b 0.3 would be wrong). Tolerance 1 %, as restitution_test for
+  // Hertz with dt = t_c/200 (the damping law gives e to within that). The
+  // masses are a's and b's densities' (momentum to round-off: 1e-12).
+  json doc = mixture_doc(1e-7);
+  doc["subdomains"][0]["insert"] = {one_sphere("a", {-kR * 1.001, 0, 0}, {0.5, 0, 0}),
+                                    one_sphere("b", {kR * 1.001, 0, 0}, {-0.5, 0, 0})};
+  auto sim = dt::build(doc);
+  auto& sd = *sim->subdomains[0];
+  ASSERT_EQ(sd.materials().size(), 2u);
+  auto& s = sd.store();
+  ASSERT_EQ(s.size(), 2u);
+  const double ma = 2500 * M_PI / 6 * kD * kD * kD, mb = 7800 * M_PI / 6 * kD * kD * kD;
+  EXPECT_NEAR(s.mass[0], ma, 1e-12 * ma);
+  EXPECT_NEAR(s.mass[1], mb, 1e-12 * mb);
+  const auto rep = sd.estimate_time_step(1.0);
+  sd.set_time_step(rep.contact_time / 200);
+  sd.set_skin(0.1 * kD);
+  sd.setup();
+  const double p0 = ma * s.vx[0] + mb * s.vx[1];
+  bool touched = false;
+  for (int k = 0; k < 100000; ++k) {
+    sd.step();
+    const bool touching = sd.stats().contacts > 0;
+    touched = touched || touching;
+    if (touched && !touching) break;
+  }
+  ASSERT_TRUE(touched);
+  EXPECT_NEAR((s.vx[1] - s.vx[0]) / 1.0, 0.6, 0.006);
+  EXPECT_NEAR(ma * s.vx[0] + mb * s.vx[1], p0, 1e-12 * std::fabs(ma * 0.5));
+}
+
+TEST(Mixture, EachSphereSlidesOnTheFloorWithTheFrictionOfItsMaterialAndTheWalls) {
+  // A sphere of a and one of b launched along a floor of material w: while
+  // they slide, |F_t| = mu F_n with mu = 0.2 (a-w) and 0.6 (b-w), read from
+  // the contact file at 1 ms (the Coulomb cap to round-off, 1e-9).
+  json doc = mixture_doc(2e-6);
+  doc["gravity"] = {0, 0, -9.81};
+  doc["walls"].push_back({{"name", "floor"}, {"type", "plane"}, {"material", "w"}, {"point", {0, 0, 0}},
+                          {"normal", {0, 0, 1}}});
+  doc["subdomains"][0]["insert"] = {one_sphere("a", {0, 0, kR}, {0.2, 0, 0}), one_sphere("b", {0, 0.01, kR}, {0.2, 0, 0})};
+  doc["run"]["duration"] = 0.001;
+  doc["output"]["contacts"] = {{"interval", 0.001}};
+  const fs::path out = fs::temp_directory_path() / ("domel_mixture_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto sim = dt::build(doc);
+  domel::platform::RunOptions opt;
+  opt.output_directory = out;
+  opt.progress = false;
+  sim->run(opt, dt::builtin_registry());
+  vtkNew<vtkXMLPolyDataReader> r;
+  r->SetFileName((out / "contacts_000001.vtp").c_str());
+  r->Update();
+  vtkPolyData* p = r->GetOutput();
+  ASSERT_EQ(p->GetNumberOfCells(), 2);
+  for (vtkIdType c = 0; c < 2; ++c) {
+    const double* ft = p->GetCellData()->GetArray("tangential_force")->GetTuple3(c);
+    const double fn = p->GetCellData()->GetArray("normal_force")->GetTuple1(c);
+    const double mu = p->GetCellData()->GetArray("id_i")->GetTuple1(c) == 1 ? 0.2 : 0.6;  // ids in insertion order
+    EXPECT_NEAR(std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]), mu * fn, 1e-9 * fn);
+    EXPECT_EQ(p->GetCellData()->GetArray("sliding")->GetTuple1(c), 1.0);
+  }
+  fs::remove_all(out);
+}
+
+TEST(Mixture, TheAutomaticTimeStepIsTheMostRestrictivePairs) {
+  // a soft and a stiff material of one density and size: the stiff pair
+  // (b-b, E* above a-b's and a-a's) sets the contact time and the limit, so
+  // the mixture's estimate equals a subdomain of b alone, to the bit.
+  json doc = mixture_doc(1e-6);
+  doc["materials"]["b"]["density"] = 2500;
+  doc["subdomains"][0]["insert"] = {one_sphere("a", {0, 0, 0}, {0, 0, 0}), one_sphere("b", {0.01, 0, 0}, {0, 0, 0})};
+  auto mixed = dt::build(doc);
+  json pure = doc;
+  pure["subdomains"][0]["material"] = "b";
+  pure["subdomains"][0]["insert"] = {one_sphere("b", {0.01, 0, 0}, {0, 0, 0})};
+  auto alone = dt::build(pure);
+  const auto m = mixed->subdomains[0]->estimate_time_step(1.0);
+  const auto b = alone->subdomains[0]->estimate_time_step(1.0);
+  EXPECT_EQ(m.contact_time, b.contact_time);
+  EXPECT_EQ(m.critical, b.critical);
+  EXPECT_EQ(m.critical_of, "contact of b with b");
+  json soft = pure;  // and a alone is slower: the estimate did take b into account
+  soft["subdomains"][0]["material"] = "a";
+  soft["subdomains"][0]["insert"] = {one_sphere("a", {0, 0, 0}, {0, 0, 0})};
+  EXPECT_GT(dt::build(soft)->subdomains[0]->estimate_time_step(1.0).contact_time, 1.1 * m.contact_time);
+}
