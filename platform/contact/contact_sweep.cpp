@@ -111,22 +111,29 @@ inline void add(const ForceAccumulator& a, uint32_t k, double fx, double fy, dou
   a.tx[k] += tx; a.ty[k] += ty; a.tz[k] += tz;
 }
 
-/// Group the first c entries of a batch by key (a stable counting sort:
-/// list order within a key) and return the runs as (first slot, key) in
-/// `runs` (closed by (c, -)). `key_of(entry)` < n_keys.
+/// Group the c contacts of a batch by key: slot_of[q] is the batch slot of
+/// contact q (a stable counting sort: contacts of one key in their order),
+/// and `runs` holds (first slot, key) of each key present, closed by (c, -).
+/// The contacts keep their order for the gather and the scatter, which read
+/// and write the particle arrays (in list order: what the cache and the
+/// prefetcher follow); only the slots they fill, in the batch's own small
+/// arrays, are grouped. `key(q)` < n_keys.
 template <class KeyOf>
-void group_by_key(uint32_t* entry, uint32_t c, uint32_t n_keys, KeyOf&& key_of, std::vector<uint32_t>& count,
-                  std::vector<uint32_t>& sorted, std::vector<std::pair<uint32_t, uint32_t>>& runs) {
+void group_by_key(uint32_t c, uint32_t n_keys, KeyOf&& key, std::vector<uint32_t>& count,
+                  std::vector<uint32_t>& slot_of, std::vector<std::pair<uint32_t, uint32_t>>& runs) {
   count.assign(n_keys + 1, 0);
-  sorted.resize(c);
-  for (uint32_t q = 0; q < c; ++q) ++count[key_of(entry[q]) + 1];
+  slot_of.resize(ContactPipeline::kBatchSize);
+  for (uint32_t q = 0; q < c; ++q) {
+    const uint32_t k = key(q);
+    slot_of[q] = k;  // the key for now, the slot below
+    ++count[k + 1];
+  }
   for (uint32_t k = 0; k < n_keys; ++k) count[k + 1] += count[k];
   runs.clear();
   for (uint32_t k = 0; k < n_keys; ++k)
     if (count[k + 1] > count[k]) runs.emplace_back(count[k], k);
   runs.emplace_back(c, 0);
-  for (uint32_t q = 0; q < c; ++q) sorted[count[key_of(entry[q])]++] = entry[q];
-  std::copy_n(sorted.begin(), c, entry);
+  for (uint32_t q = 0; q < c; ++q) slot_of[q] = count[slot_of[q]]++;
 }
 
 template <bool kZoned, bool kTorque, bool kMasses, bool kMixed>
@@ -186,13 +193,17 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     const uint8_t* __restrict mat = s.material.data();
     const uint32_t nm = sw.n_materials;
     if constexpr (kMixed)
-      group_by_key(entry, c, nm * nm, [&](uint32_t le) {
-        const uint32_t a = mat[li[le]], b = mat[lj[le]];
+      group_by_key(c, nm * nm, [&](uint32_t q) {
+        const uint32_t a = mat[li[entry[q]]], b = mat[lj[entry[q]]];
         return a < b ? a * nm + b : b * nm + a;  // (a, b) and (b, a) share their constants: one run
       }, ts.key_count, ts.sorted, ts.runs);
-    // Phase B: the gather (contact geometry and relative velocities).
+    const uint32_t* slot_of = ts.sorted.data();
+    // Phase B: the gather (contact geometry and relative velocities) of
+    // contact q into slot sl (q itself, or its pair's run).
     for (uint32_t q = 0; q < c; ++q) {
       const uint32_t le = entry[q];
+      uint32_t sl = q;
+      if constexpr (kMixed) sl = slot_of[q];
       const uint32_t i = li[le], j = lj[le];
       const double ri = pr[i], rj = pr[j];
       const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
@@ -209,13 +220,13 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       point_velocity(pvx[j], pvy[j], pvz[j], wjx, wjy, wjz, cj, nx, ny, nz, vjx, vjy, vjz);
       // one division for R* and the overlap ratio
       const double mi = pm[i], mj = pm[j];
-      fill_slot(slots, kMasses, q, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, mi, mj, mi * mj / (mi + mj),
+      fill_slot(slots, kMasses, sl, delta, nx, ny, nz, ri, rj, ri * rj * inv_rsum, mi, mj, mi * mj / (mi + mj),
                 vix - vjx, viy - vjy, viz - vjz, wix - wjx, wiy - wjy, wiz - wjz);
-      copy_row(list_history + static_cast<std::size_t>(le) * stride, b_hist + static_cast<std::size_t>(q) * stride,
+      copy_row(list_history + static_cast<std::size_t>(le) * stride, b_hist + static_cast<std::size_t>(sl) * stride,
                stride);
       touching[le] = 1;
-      lever_i[q] = ci;
-      lever_j[q] = cj;
+      lever_i[sl] = ci;
+      lever_j[sl] = cj;
       max_ratio = std::max(max_ratio, delta * inv_rsum);
     }
     try {
@@ -237,14 +248,16 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     const double* __restrict tqz_ = buf.tqz.data();
     for (uint32_t q = 0; q < c; ++q) {
       const uint32_t le = entry[q];
+      uint32_t sl = q;
+      if constexpr (kMixed) sl = slot_of[q];
       const uint32_t i = li[le], j = lj[le];
-      const Load l = load_of(fn_[q], slots.nx[q], slots.ny[q], slots.nz[q], ftx_[q], fty_[q], ftz_[q]);
-      const double ci = lever_i[q], cj = lever_j[q];
+      const Load l = load_of(fn_[sl], slots.nx[sl], slots.ny[sl], slots.nz[sl], ftx_[sl], fty_[sl], ftz_[sl]);
+      const double ci = lever_i[sl], cj = lever_j[sl];
       double tix = -ci * l.cx, tiy = -ci * l.cy, tiz = -ci * l.cz;
       double tjx = -cj * l.cx, tjy = -cj * l.cy, tjz = -cj * l.cz;
       if constexpr (kTorque) {  // else the couple is zero, and adding it would change no bit (sums start at +0)
-        tix += tqx_[q]; tiy += tqy_[q]; tiz += tqz_[q];
-        tjx -= tqx_[q]; tjy -= tqy_[q]; tjz -= tqz_[q];
+        tix += tqx_[sl]; tiy += tqy_[sl]; tiz += tqz_[sl];
+        tjx -= tqx_[sl]; tjy -= tqy_[sl]; tjz -= tqz_[sl];
       }
       // A branch, not a select of the accumulator: it is taken the same way
       // for all but the few particles of the band other threads share, and
@@ -253,13 +266,15 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       else add(shared_acc, i, l.fx, l.fy, l.fz, tix, tiy, tiz);
       if (!kZoned || j - zone_lo < zone_width) add(own_acc, j, -l.fx, -l.fy, -l.fz, tjx, tjy, tjz);
       else add(shared_acc, j, -l.fx, -l.fy, -l.fz, tjx, tjy, tjz);
-      copy_row(b_hist + static_cast<std::size_t>(q) * stride, list_history + static_cast<std::size_t>(le) * stride,
+      copy_row(b_hist + static_cast<std::size_t>(sl) * stride, list_history + static_cast<std::size_t>(le) * stride,
                stride);
     }
     if (sw.record)
       for (uint32_t q = 0; q < c; ++q) {
         const uint32_t le = entry[q];
-        const Load l = load_of(fn_[q], slots.nx[q], slots.ny[q], slots.nz[q], ftx_[q], fty_[q], ftz_[q]);
+        uint32_t sl = q;
+        if constexpr (kMixed) sl = slot_of[q];
+        const Load l = load_of(fn_[sl], slots.nx[sl], slots.ny[sl], slots.nz[sl], ftx_[sl], fty_[sl], ftz_[sl]);
         ts.records.push_back({li[le], lj[le], l.fx, l.fy, l.fz, 0.0, 0.0, 0.0});
       }
     contacts += c;
@@ -323,7 +338,10 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         throw_batch_failure(err, s, ts.entry.data(), c, list.particle.data(),
                             [&](uint32_t) { return "wall '" + wall.name + "'"; });
       }
-      for (uint32_t q = 0; q < c; ++q) {
+      // in the particles' order (several materials: slot q of the k-th staged contact)
+      const uint32_t* order = mixed ? ts.sorted.data() : nullptr;
+      for (uint32_t k = 0; k < c; ++k) {
+        const uint32_t q = order ? order[k] : k;
         const uint32_t e = ts.entry[q];
         const uint32_t i = list.particle[e];
         const double nx = buf.nx[q], ny = buf.ny[q], nz = buf.nz[q];
@@ -344,7 +362,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
     // The wall is partner j: no radius, no rotation, its surface velocity
     // at the contact point x_i - c_i n when it moves.
     const bool moving = wall.moving;
-    auto gather = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
+    auto gather = [&](uint32_t q, std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
       const double delta = s.radius[i] - d;
       const double ci = s.radius[i] - delta;
       double rx, ry, rz;
@@ -354,36 +372,34 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         wall.surface_velocity(sw.wall_time, s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
         rx -= ux; ry -= uy; rz -= uz;
       }
-      fill_slot(slots, masses, c, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], 0.0, s.mass[i], rx, ry, rz,
+      fill_slot(slots, masses, q, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], 0.0, s.mass[i], rx, ry, rz,
                 s.wx[i], s.wy[i], s.wz[i]);
-      copy_row(list.history.data() + e * stride, buf.history.data() + c * stride, stride);
+      copy_row(list.history.data() + e * stride, buf.history.data() + q * stride, stride);
       list.touching[e] = 1;
-      ts.entry[c] = static_cast<uint32_t>(e);
-      ts.ci[c] = ci;
+      ts.entry[q] = static_cast<uint32_t>(e);
+      ts.ci[q] = ci;
       max_ratio = std::max(max_ratio, delta / (2.0 * s.radius[i]));
-      ++c;
     };
-    // Several materials: the contacts are staged, then grouped by the
-    // particle's material before the gather, so that each run of one wall
-    // pair is evaluated with its own constants.
+    // Several materials: the contacts are staged, then each is gathered (in
+    // the particles' order) into a slot of its material's run, so that each
+    // run of one wall pair is evaluated with its own constants.
     auto flush_staged = [&]() {
       if (ts.staged.empty()) return;
       const auto n = static_cast<uint32_t>(ts.staged.size());
-      for (uint32_t q = 0; q < n; ++q) ts.entry[q] = q;
-      group_by_key(ts.entry.data(), n, sw.n_materials,
+      group_by_key(n, sw.n_materials,
                    [&](uint32_t k) { return static_cast<uint32_t>(s.material[ts.staged[k].particle]); }, ts.key_count,
                    ts.sorted, ts.runs);
-      for (uint32_t q = 0; q < n; ++q) ts.sorted[q] = ts.entry[q];  // gather() overwrites entry[]
-      for (uint32_t q = 0; q < n; ++q) {
-        const auto& k = ts.staged[ts.sorted[q]];
-        gather(k.entry, k.particle, k.d, k.nx, k.ny, k.nz);
+      for (uint32_t k = 0; k < n; ++k) {
+        const auto& st = ts.staged[k];
+        gather(ts.sorted[k], st.entry, st.particle, st.d, st.nx, st.ny, st.nz);
       }
+      c = n;
       ts.staged.clear();
       flush();
     };
     auto push = [&](std::size_t e, uint32_t i, double d, double nx, double ny, double nz) {
       if (!mixed) {
-        gather(e, i, d, nx, ny, nz);
+        gather(c++, e, i, d, nx, ny, nz);
         if (c == ContactPipeline::kBatchSize) flush();
         return;
       }

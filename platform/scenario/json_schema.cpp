@@ -629,23 +629,26 @@ struct SchemaValidator::State {
       }
     }
     if (matching.size() == 1) return true;
-    if (matching.size() > 1) {
-      // Branches that only require keys ("oneOf": [{"required": ["a"]}, {"required": ["b"]}])
-      // express "give exactly one of a, b": say that in those words.
-      std::vector<std::string> keys;
-      bool only_required = exactly_one;
-      for (const auto& b : branches) {
-        if (!b.is_object() || b.size() != 1 || !b.contains("required") || b["required"].size() != 1 ||
-            !b["required"][0].is_string()) {
-          only_required = false;
-          break;
-        }
-        keys.push_back("'" + b["required"][0].get<std::string>() + "'");
+    // Branches that only require keys ("oneOf": [{"required": ["a"]}, {"required": ["b"]}])
+    // express "give exactly one of a, b": say that in those words.
+    std::vector<std::string> keys;
+    bool only_required = exactly_one;
+    for (const auto& b : branches) {
+      if (!b.is_object() || b.size() != 1 || !b.contains("required") || b["required"].size() != 1 ||
+          !b["required"][0].is_string()) {
+        only_required = false;
+        break;
       }
+      keys.push_back("'" + b["required"][0].get<std::string>() + "'");
+    }
+    std::string list;
+    for (std::size_t i = 0; i < keys.size(); ++i) list += (i == 0 ? "" : i + 1 == keys.size() ? " or " : ", ") + keys[i];
+    if (only_required && matching.empty() && v.is_object())
+      return fail(out, ptr, "missing required property: expected one of " + list + ", found none",
+                  "give one of them");
+    if (matching.size() > 1) {
       if (only_required) {
-        std::string list, given;
-        for (std::size_t i = 0; i < keys.size(); ++i)
-          list += (i == 0 ? "" : i + 1 == keys.size() ? " or " : ", ") + keys[i];
+        std::string given;
         for (std::size_t i = 0; i < matching.size(); ++i)
           given += (i == 0 ? "" : i + 1 == matching.size() ? " and " : ", ") + keys[matching[i]];
         return fail(out, ptr, "expected exactly one of " + list + ", found " + given,

@@ -21,6 +21,9 @@
 #include "region.hpp"
 
 #include <domel/sdk/plugin.hpp>
+#include <domel/sdk/size_distribution.hpp>
+
+#include <optional>
 
 #include <cmath>
 #include <cstddef>
@@ -36,7 +39,7 @@ class Lattice {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_INSERTION;
   static constexpr const char* kName = "lattice";
-  static constexpr const char* kVersion = "1.1.0";
+  static constexpr const char* kVersion = "1.2.0";
   static constexpr const char* kSummary =
       "equal spheres on a simple cubic lattice filling the region, optionally jittered";
   static constexpr const char* kSchema = R"json({
@@ -54,15 +57,16 @@ class Lattice {
                "description": "stop after this many particles (default: fill every site)" },
     "arrangement": { "enum": ["simple_cubic"], "default": "simple_cubic",
                      "description": "lattice type" },
+    "distribution": { "type": "object", "description": "particle diameters drawn from a distribution by number, in place of diameter; the lattice is spaced for the largest (multiplied by alpha): {\"type\": \"uniform\", \"min\", \"max\"}, {\"type\": \"normal\", \"mean\", \"std\", \"min\", \"max\"} (truncated, default mean +- 3 std), {\"type\": \"lognormal\", \"median\", \"sigma\" (of ln d), \"min\", \"max\"} (truncated, default median e^(+-3 sigma)) or {\"type\": \"table\", \"diameters\": [...], \"fractions\": [...], \"by\": \"number\" or \"mass\"}; docs/getting-started.md, \"Size distributions\"" },
     "origin": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m",
                 "description": "anchor the lattice: sites at origin + (i + 0.5) a for integer i (default: the region's lower corner), e.g. to reproduce another code's lattice" }
   },
-  "required": ["diameter"],
+  "oneOf": [ { "required": ["diameter"] }, { "required": ["distribution"] } ],
   "additionalProperties": false
 })json";
 
   explicit Lattice(const sdk::Params& p)
-      : diameter_(p.number("diameter")),
+      : diameter_(p.has("distribution") ? largest(p) : p.number("diameter")),
         spacing_(p.number_or("spacing", 1.0)),
         jitter_(p.number_or("jitter", 0.0)) {
     if (!std::isfinite(diameter_) || !(diameter_ > 0.0))
@@ -140,6 +144,7 @@ class Lattice {
     }
 
     std::mt19937_64 rng(req.seed);
+    std::mt19937_64 sizes(req.seed ^ 0x9e3779b97f4a7c15ull);  // the diameters' own stream: the jitter's is unchanged
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     bool any_site = false;
     for (long long iz = 0; iz < n[2]; ++iz)
@@ -158,7 +163,7 @@ class Lattice {
             if (!sphere_inside(g, x, y, z, r)) { x = sx; y = sy; z = sz; }
           }
           if (existing && existing->overlaps(x, y, z, r)) continue;
-          out.push(x, y, z, r);
+          out.push(x, y, z, distribution_ ? 0.5 * alpha * distribution_->sample(sizes) : r);
           if (count_ != 0 && out.size() >= count_) return;
         }
     if (!any_site) {
@@ -172,6 +177,16 @@ class Lattice {
  private:
   static constexpr double kMaxSites = 2e8;
 
+  /// A distribution's largest diameter, which spaces the lattice.
+  double largest(const sdk::Params& p) {
+    if (p.has("diameter")) throw sdk::ParameterError("lattice: give either 'distribution' or 'diameter', not both");
+    distribution_ = sdk::SizeDistribution::parse(p.json().at("distribution"), "lattice: 'distribution'");
+    return distribution_->max();
+  }
+
+  /// Diameters by number; the lattice is spaced for the largest. Declared
+  /// first: diameter_'s initialiser (largest()) sets it.
+  std::optional<sdk::SizeDistribution> distribution_;
   double diameter_;
   double spacing_;
   double jitter_;

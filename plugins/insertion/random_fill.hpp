@@ -17,6 +17,12 @@
 // 74, 061308 (2006)), and gets slow well before it; bounded regions jam
 // earlier still because of their walls. A particle that finds no place in
 // max_attempts draws makes the insertion fail with an explanation.
+// With a `distribution` (domel/sdk/size_distribution.hpp) every diameter is
+// drawn first and the spheres are placed largest first, since RSA rejects a
+// large sphere more often than a small one and would otherwise jam before
+// the large ones are in; the placed spheres are then handed over in random
+// order, so that any first part of them (a pour keeps the first ones until
+// its mass is reached) has the requested composition.
 // Deterministic: std::mt19937_64 seeded with the request's seed.
 // Units: diameters in m; volume_fraction dimensionless.
 #pragma once
@@ -24,6 +30,7 @@
 #include "region.hpp"
 
 #include <domel/sdk/plugin.hpp>
+#include <domel/sdk/size_distribution.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -40,7 +47,7 @@ class RandomFill {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_INSERTION;
   static constexpr const char* kName = "random";
-  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kVersion = "1.1.0";
   static constexpr const char* kSummary =
       "non-overlapping spheres at random positions (sequential simple inhibition / RSA)";
   static constexpr const char* kSchema = R"json({
@@ -52,6 +59,7 @@ class RandomFill {
                   "description": "particle diameter, or the smallest diameter when diameter_max is given (multiplied by the subdomain's coarse-grain ratio alpha)" },
     "diameter_max": { "type": "number", "exclusiveMinimum": 0, "x-unit": "m",
                       "description": "largest diameter: diameters are then uniform in [diameter, diameter_max]; must not be below diameter" },
+    "distribution": { "type": "object", "description": "particle diameters drawn from a distribution by number, in place of diameter (multiplied by alpha): {\"type\": \"uniform\", \"min\", \"max\"}, {\"type\": \"normal\", \"mean\", \"std\", \"min\", \"max\"} (truncated, default mean +- 3 std), {\"type\": \"lognormal\", \"median\", \"sigma\" (of ln d), \"min\", \"max\"} (truncated, default median e^(+-3 sigma)) or {\"type\": \"table\", \"diameters\": [...], \"fractions\": [...], \"by\": \"number\" or \"mass\"}; docs/getting-started.md, \"Size distributions\"" },
     "count": { "type": "integer", "minimum": 1, "maximum": 100000000,
                "description": "number of particles to insert" },
     "volume_fraction": { "type": "number", "exclusiveMinimum": 0, "maximum": 0.38, "x-unit": "1",
@@ -59,13 +67,21 @@ class RandomFill {
     "max_attempts": { "type": "integer", "minimum": 1, "maximum": 1000000000, "default": 1000,
                       "description": "candidate positions drawn for one particle before the insertion fails" }
   },
-  "required": ["diameter"],
-  "oneOf": [ { "required": ["count"] }, { "required": ["volume_fraction"] } ],
+  "allOf": [ { "oneOf": [ { "required": ["count"] }, { "required": ["volume_fraction"] } ] },
+             { "oneOf": [ { "required": ["diameter"] }, { "required": ["distribution"] } ] } ],
   "additionalProperties": false
 })json";
 
   explicit RandomFill(const sdk::Params& p)
-      : d_min_(p.number("diameter")), d_max_(p.number_or("diameter_max", d_min_)) {
+      : d_min_(p.has("distribution") ? 1.0 : p.number("diameter")), d_max_(p.number_or("diameter_max", d_min_)) {
+    if (p.has("distribution")) {
+      if (p.has("diameter") || p.has("diameter_max"))
+        throw sdk::ParameterError("random: give either 'distribution' or 'diameter' (and 'diameter_max'), not both");
+      distribution_ = sdk::SizeDistribution::parse(p.json().at("distribution"), "random: 'distribution'");
+      has_distribution_ = true;
+      d_min_ = distribution_.min();
+      d_max_ = distribution_.max();
+    }
     if (!std::isfinite(d_min_) || !(d_min_ > 0.0))
       throw sdk::ParameterError("random: 'diameter' must be > 0");
     if (!std::isfinite(d_max_) || !(d_max_ > 0.0))
@@ -102,7 +118,7 @@ class RandomFill {
     const double alpha = checked_length_scale(req, kName);
     const double d_lo = d_min_ * alpha, d_hi = d_max_ * alpha;
     const double volume = region_volume(g);
-    const std::size_t target = target_count(volume, d_lo, d_hi);
+    const std::size_t target = target_count(volume, d_lo, d_hi, alpha);
     out.expect(static_cast<double>(target));
     const Bounds b = region_bounds(g);
 
@@ -112,10 +128,20 @@ class RandomFill {
 
     std::mt19937_64 rng(req.seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
-    out.x.reserve(target); out.y.reserve(target); out.z.reserve(target); out.r.reserve(target);
+    // a distribution: every diameter first, placed largest first into a
+    // buffer that is handed over shuffled (see the file's comment)
+    std::vector<double> drawn;
+    sdk::Inserted placed_sorted;
+    sdk::Inserted& dest = has_distribution_ ? placed_sorted : out;
+    if (has_distribution_) {
+      drawn.resize(target);
+      for (double& d : drawn) d = alpha * distribution_.sample(rng);
+      std::sort(drawn.begin(), drawn.end(), [](double a, double b) { return a > b; });
+    }
+    dest.x.reserve(target); dest.y.reserve(target); dest.z.reserve(target); dest.r.reserve(target);
     double solid = 0.0;  // volume of the spheres placed so far
     for (std::size_t n = 0; n < target; ++n) {
-      const double d = d_hi > d_lo ? d_lo + (d_hi - d_lo) * unit(rng) : d_lo;
+      const double d = has_distribution_ ? drawn[n] : d_hi > d_lo ? d_lo + (d_hi - d_lo) * unit(rng) : d_lo;
       const double r = 0.5 * d;
       check_fits(g, r);
       bool placed = false;
@@ -124,7 +150,7 @@ class RandomFill {
         draw_centre(g, r, rng, unit, p);
         if (grid.overlaps(p[0], p[1], p[2], r)) continue;
         grid.add(p[0], p[1], p[2], r);
-        out.push(p[0], p[1], p[2], r);
+        dest.push(p[0], p[1], p[2], r);
         solid += kPi / 6.0 * d * d * d;
         placed = true;
       }
@@ -137,6 +163,12 @@ class RandomFill {
         throw std::runtime_error(m.str());
       }
     }
+    if (has_distribution_) {
+      std::vector<std::size_t> order(placed_sorted.size());
+      for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::shuffle(order.begin(), order.end(), rng);
+      for (std::size_t k : order) out.push(placed_sorted.x[k], placed_sorted.y[k], placed_sorted.z[k], placed_sorted.r[k]);
+    }
   }
 
  private:
@@ -145,11 +177,11 @@ class RandomFill {
 
   /// Particles to insert: `count`, or from the volume fraction with the mean
   /// sphere volume (pi/6) E[d^3] of the diameter distribution.
-  std::size_t target_count(double volume, double d_lo, double d_hi) const {
+  std::size_t target_count(double volume, double d_lo, double d_hi, double alpha) const {
     if (count_ != 0) return count_;
-    const double mean_d3 = d_hi > d_lo
-                               ? (std::pow(d_hi, 4) - std::pow(d_lo, 4)) / (4.0 * (d_hi - d_lo))
-                               : d_lo * d_lo * d_lo;
+    const double mean_d3 = has_distribution_ ? distribution_.mean_cube() * alpha * alpha * alpha
+                           : d_hi > d_lo     ? (std::pow(d_hi, 4) - std::pow(d_lo, 4)) / (4.0 * (d_hi - d_lo))
+                                             : d_lo * d_lo * d_lo;
     const double n = std::round(volume * volume_fraction_ / (kPi / 6.0 * mean_d3));
     if (!(n >= 1.0)) {
       std::ostringstream m;
@@ -201,6 +233,8 @@ class RandomFill {
 
   double d_min_;
   double d_max_;
+  sdk::SizeDistribution distribution_;
+  bool has_distribution_ = false;
   std::size_t count_ = 0;         // 0: use volume_fraction_
   double volume_fraction_ = 0.0;
   std::size_t max_attempts_ = 1000;

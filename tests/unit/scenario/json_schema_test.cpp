@@ -262,10 +262,19 @@ TEST(JsonSchema, OneOfWithoutClearBranch) {
   const auto none = check(schema, json::object(), "/run");
   ASSERT_EQ(none.size(), 1u);
   EXPECT_EQ(none[0].pointer, "/run");
-  EXPECT_EQ(none[0].message, "does not match any of the allowed forms");
-  EXPECT_EQ(
-      none[0].hint,
-      "form 1: missing required property 'duration'; form 2: missing required property 'steps'");
+  // branches that only require a key: "give one of these keys", in those words
+  EXPECT_EQ(none[0].message, "missing required property: expected one of 'duration' or 'steps', found none");
+  EXPECT_EQ(none[0].hint, "give one of them");
+  // other forms that none matches: the generic message naming each form's problem
+  const json forms = json::parse(R"({
+    "type": "object",
+    "oneOf": [ { "required": ["duration"], "properties": { "duration": { "type": "number" } } },
+               { "required": ["steps"] } ]
+  })");
+  const auto other = check(forms, json::object(), "/run");
+  ASSERT_EQ(other.size(), 1u);
+  EXPECT_EQ(other[0].message, "does not match any of the allowed forms");
+  EXPECT_EQ(other[0].hint, "form 1: missing required property 'duration'; form 2: missing required property 'steps'");
 }
 
 // Guards oneOf matched by several branches.
