@@ -19,6 +19,18 @@ namespace domel::platform::io {
 
 namespace fs = std::filesystem;
 
+namespace {
+/// A cell array of n tuples of `components`, named.
+template <class Array>
+vtkNew<Array> named(const char* name, vtkIdType n, int components = 1) {
+  vtkNew<Array> a;
+  a->SetName(name);
+  a->SetNumberOfComponents(components);
+  a->SetNumberOfTuples(n);
+  return a;
+}
+}  // namespace
+
 ContactSeriesWriter::ContactSeriesWriter(fs::path directory, std::string basename)
     : frames_(std::move(directory), std::move(basename), "vtp") {}
 
@@ -27,40 +39,15 @@ fs::path ContactSeriesWriter::write(double time, const std::vector<ContactRow>& 
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(2 * n);
-  auto vec = [n](const char* name) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->SetNumberOfComponents(3);
-    a->SetNumberOfTuples(n);
-    return a;
-  };
-  auto scalar = [n](const char* name) {
-    vtkNew<vtkDoubleArray> a;
-    a->SetName(name);
-    a->SetNumberOfTuples(n);
-    return a;
-  };
-  auto integer = [n](const char* name) {
-    vtkNew<vtkIntArray> a;
-    a->SetName(name);
-    a->SetNumberOfTuples(n);
-    return a;
-  };
-  auto id = [n](const char* name) {
-    vtkNew<vtkTypeUInt64Array> a;
-    a->SetName(name);
-    a->SetNumberOfTuples(n);
-    return a;
-  };
-  auto force = vec("force");
-  auto tangential = vec("tangential_force");
-  auto normal = scalar("normal_force");
-  auto overlap = scalar("overlap");
-  auto id_i = id("id_i");
-  auto id_j = id("id_j");
-  auto subdomain = integer("subdomain");
-  auto wall = integer("wall");
-  auto sliding = integer("sliding");
+  auto force = named<vtkDoubleArray>("force", n, 3);
+  auto tangential = named<vtkDoubleArray>("tangential_force", n, 3);
+  auto normal = named<vtkDoubleArray>("normal_force", n);
+  auto overlap = named<vtkDoubleArray>("overlap", n);
+  auto id_i = named<vtkTypeUInt64Array>("id_i", n);
+  auto id_j = named<vtkTypeUInt64Array>("id_j", n);
+  auto subdomain = named<vtkIntArray>("subdomain", n);
+  auto wall = named<vtkIntArray>("wall", n);
+  auto sliding = named<vtkIntArray>("sliding", n);
   vtkNew<vtkIdTypeArray> offsets;
   offsets->SetNumberOfTuples(n + 1);
   vtkNew<vtkIdTypeArray> connectivity;

@@ -711,12 +711,8 @@ bool walls_and_regions_bounds(Build& b, double lo[3], double hi[3], bool all) {
     any = true;
   };
   auto grow_region = [&](const domel_region_v1& r) {
-    if (r.shape == 1) return grow(r.lo, r.hi);
     double a[3], z[3];
-    for (int k = 0; k < 3; ++k) {
-      a[k] = k == static_cast<int>(r.axis) ? r.lo[k] : r.center[k] - r.radius;
-      z[k] = k == static_cast<int>(r.axis) ? r.hi[k] : r.center[k] + r.radius;
-    }
+    region_box(r, a, z);
     grow(a, z);
   };
   for (const auto& w : b.sim.walls) {
@@ -800,11 +796,7 @@ void warn_shared_space(Build& b) {
   }
   for (const auto& p : b.sim.flow.pours) {
     double lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      const bool along = p.region.shape == 1 || a == static_cast<int>(p.region.axis);
-      lo[a] = along ? p.region.lo[a] : p.region.center[a] - p.region.radius;
-      hi[a] = along ? p.region.hi[a] : p.region.center[a] + p.region.radius;
-    }
+    region_box(p.region, lo, hi);
     if (p.subdomain < n) grow(p.subdomain, lo, hi);
   }
   for (std::size_t x = 0; x < n; ++x)
@@ -1285,13 +1277,6 @@ std::optional<FluidSpec> build_fluid(Build& b) {
                      "enlarge the coupler's grid to the particles' whole domain");
             return;
           }
-      };
-      auto region_box = [](const domel_region_v1& r, double lo[3], double hi[3]) {
-        for (int k = 0; k < 3; ++k) {
-          const bool along = r.shape == 1 || k == static_cast<int>(r.axis);
-          lo[k] = along ? r.lo[k] : r.center[k] - r.radius;
-          hi[k] = along ? r.hi[k] : r.center[k] + r.radius;
-        }
       };
       for (std::size_t k : spec.levels) {
         const json& sd = b.doc["subdomains"][k];

@@ -92,6 +92,9 @@ inline json plugin_params(const json& block, uint32_t kind) {
 /// A region block ({"box": ...} or {"cylinder": ...}) as the ABI's region (shapes.cpp).
 domel_region_v1 make_region(const json& region);
 
+/// The axis-aligned box [lo, hi] enclosing a region (a cylinder: its radius about the axis).
+void region_box(const domel_region_v1& r, double lo[3], double hi[3]);
+
 /// A wall block as its primitives, remove_at and motion applied (shapes.cpp).
 /// Throws MeshError when a mesh file cannot be read.
 std::vector<WallPrimitive> expand_wall(const json& w, std::size_t wall_index, std::size_t material,

@@ -41,6 +41,14 @@ domel_region_v1 make_region(const json& region) {
   return r;
 }
 
+void region_box(const domel_region_v1& r, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) {
+    const bool along = r.shape == 1 || k == static_cast<int>(r.axis);
+    lo[k] = along ? r.lo[k] : r.center[k] - r.radius;
+    hi[k] = along ? r.hi[k] : r.center[k] + r.radius;
+  }
+}
+
 namespace {
 
 std::vector<WallPrimitive> expand_wall_shape(const json& w, std::size_t material,

@@ -510,7 +510,7 @@ TEST(InsertionAbi, RoundTripWithCapacityRetry) {
 // fractions within 2 %, and so does the first half of what it hands over
 // (a pour keeps a first part: the large ones are placed first but handed
 // over shuffled); a lattice of log-normal diameters passes a
-// Kolmogorov-Smirnov test (1.63/sqrt(n), 1 %) against the truncated CDF;
+// Kolmogorov-Smirnov test (1.63/sqrt(n), the 1 % point; Massey 1951) against the truncated CDF;
 // no sphere overlaps another or leaves the region.
 TEST(InsertionDistribution, ARandomFillMeetsATablesMassFractionsAndSoDoesItsFirstHalf) {
   const json p = {{"model", "random"}, {"count", 10000},
