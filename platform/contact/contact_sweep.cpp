@@ -324,6 +324,11 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
     // this wall's pair constants, by the particle's local material
     const domel_pair_v2* wall_pairs = sw.pairs + w * sw.n_materials;
     const bool mixed = sw.n_materials > 1;
+    double* load = nullptr;
+    if (wall.track_load) {
+      if (ts.wall_load.size() < 3 * sw.lists->size()) ts.wall_load.resize(3 * sw.lists->size(), 0.0);
+      load = ts.wall_load.data() + 3 * w;
+    }
     auto flush = [&]() {
       if (c == 0) return;
       try {
@@ -350,6 +355,9 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         const double ci = ts.ci[q];
         s.tx[i] += -ci * l.cx + buf.tqx[q]; s.ty[i] += -ci * l.cy + buf.tqy[q]; s.tz[i] += -ci * l.cz + buf.tqz[q];
         copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
+        if (load) {
+          load[0] += l.fx; load[1] += l.fy; load[2] += l.fz;
+        }
         if (sw.record)  // the contact point lies on the wall, ci from the centre along -n
           ts.records.push_back({i, ContactRecord::kWall, l.fx, l.fy, l.fz, s.x[i] - ci * nx, s.y[i] - ci * ny,
                                 s.z[i] - ci * nz, static_cast<uint32_t>(w)});
@@ -369,7 +377,7 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
       point_velocity(s.vx[i], s.vy[i], s.vz[i], s.wx[i], s.wy[i], s.wz[i], -ci, nx, ny, nz, rx, ry, rz);
       if (moving) {
         double ux, uy, uz;
-        wall.surface_velocity(sw.wall_time, s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
+        wall.surface_velocity(s.x[i] - ci * nx, s.y[i] - ci * ny, s.z[i] - ci * nz, ux, uy, uz);
         rx -= ux; ry -= uy; rz -= uz;
       }
       fill_slot(slots, masses, q, delta, nx, ny, nz, s.radius[i], 0.0, s.radius[i], s.mass[i], 0.0, s.mass[i], rx, ry, rz,

@@ -49,6 +49,7 @@ struct ContactScratch {
   std::vector<uint32_t> entry;         ///< list entry of each batch slot
   std::vector<double> ci, cj;          ///< lever arms of each batch slot
   std::vector<ContactRecord> records;  ///< contact forces on recording steps
+  std::vector<double> wall_load;       ///< per wall primitive with track_load: the force on its particles (x, y, z)
   /// Several materials: the batch's grouping by material pair (counts,
   /// the sorted entries, the runs as (first slot, pair)) and the wall
   /// contacts staged before it.

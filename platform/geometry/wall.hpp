@@ -9,15 +9,15 @@
 // centre). Meshes have many features per particle and are evaluated by
 // mesh_contacts() (geometry/triangle_mesh.hpp) instead of gap().
 //
-// A primitive may move (WallPrimitive::moving): a constant translation
-// velocity and a constant angular velocity about an axis through `origin`,
-// between `motion_start` and `motion_end`. place() moves the geometry to a
-// given time; surface_velocity() gives the velocity of a surface point.
-// Analytic primitives rotate only about their own axis (their geometry does
-// not change, only the surface velocity); meshes rotate about any axis.
+// A primitive may move (WallPrimitive::moving): its wall's list of motion
+// items (geometry/wall_motion.hpp). place() moves the geometry to a given
+// time; surface_velocity() gives the velocity of a surface point there.
+// Analytic primitives rotate only about axes parallel to their own (a plane
+// or a disk about its normal); meshes rotate about any axis.
 #pragma once
 
 #include "geometry/triangle_mesh.hpp"
+#include "geometry/wall_motion.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -67,73 +67,74 @@ struct WallPrimitive {
   double remove_at = std::numeric_limits<double>::infinity();
   /// simulated time from which the wall acts (an outlet that opens); contacts start with zero history
   double active_from = -std::numeric_limits<double>::infinity();
+  /// sum the contact forces on it (Subdomain::wall_load: a servo wall)
+  bool track_load = false;
 
-  // motion: translation velocity, angular velocity about an axis through origin
+  // motion (geometry/wall_motion.hpp): null for a wall at rest
   bool moving = false;
-  double velocity[3] = {0, 0, 0};
-  double omega[3] = {0, 0, 0};
-  double origin[3] = {0, 0, 0};
-  double motion_start = 0.0;
-  double motion_end = std::numeric_limits<double>::infinity();
-  double offset[3] = {0, 0, 0};  ///< translation applied by the last place()
-  double angle = 0.0;            ///< rotation angle applied by the last place() [rad]
+  std::shared_ptr<const WallMotion> motion;
+  std::vector<double> reach;  ///< per motion item: a rotation's reach (WallMotion::displacement_bound)
+  WallPose pose;              ///< the placement applied by the last place()
 
   bool active(double t) const { return t >= active_from && t < remove_at; }
 
-  /// Time spent moving up to t.
-  double elapsed(double t) const { return std::max(0.0, std::min(t, motion_end) - motion_start); }
-
-  /// Upper bound of how far any surface point moved between the elapsed
-  /// motion times e0 and e1 (the wall list is rebuilt beyond skin/2).
-  double displacement_bound(double e0, double e1) const {
-    const double de = std::fabs(e1 - e0);
-    const double v = std::sqrt(velocity[0] * velocity[0] + velocity[1] * velocity[1] + velocity[2] * velocity[2]);
-    double rot = 0.0;
-    if (shape == Shape::mesh && mesh) {
-      const double w = std::sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2]);
-      rot = w * de * mesh->max_distance_from(origin);  // chord <= arc
+  /// Give this primitive (in its reference placement) a motion; a null or
+  /// empty one leaves it at rest.
+  void set_motion(std::shared_ptr<const WallMotion> m) {
+    moving = m && !m->items.empty();
+    motion = moving ? std::move(m) : nullptr;
+    reach.assign(moving ? motion->items.size() : 0, 0.0);
+    for (std::size_t i = 0; i < reach.size(); ++i) {
+      const MotionItem& it = motion->items[i];
+      if (it.kind != MotionItem::Kind::rotation) continue;
+      if (shape == Shape::mesh) {
+        reach[i] = mesh ? mesh->max_distance_from(it.origin) : 0.0;
+        continue;
+      }
+      // an analytic primitive turns about an axis parallel to its own: it
+      // moves only by the distance of its own axis (centre) from that one
+      const double w = std::sqrt(it.vec[0] * it.vec[0] + it.vec[1] * it.vec[1] + it.vec[2] * it.vec[2]);
+      if (shape == Shape::plane || w <= 0.0) continue;
+      const double* ref = shape == Shape::annulus ? p : c;
+      const double r[3] = {ref[0] - it.origin[0], ref[1] - it.origin[1], ref[2] - it.origin[2]};
+      const double along = (r[0] * it.vec[0] + r[1] * it.vec[1] + r[2] * it.vec[2]) / w;
+      reach[i] = std::sqrt(std::max(0.0, r[0] * r[0] + r[1] * r[1] + r[2] * r[2] - along * along));
     }
-    return v * de + rot;
   }
 
-  /// Move the geometry of `base` (this primitive's reference state) to time t.
+  /// Upper bound of how far any point of the primitive moved between t0 and
+  /// t1 (the wall list is rebuilt beyond skin/2).
+  double displacement_bound(double t0, double t1) const {
+    return moving ? motion->displacement_bound(t0, t1, reach) : 0.0;
+  }
+
+  /// Move the geometry of `base` (this primitive's reference state) to time
+  /// t. Analytic primitives keep their normal and axis (their rotations are
+  /// about an axis parallel to it: validated with the scenario).
   void place(const WallPrimitive& base, double t) {
-    const double e = elapsed(t);
-    for (int a = 0; a < 3; ++a) offset[a] = velocity[a] * e;
-    for (int a = 0; a < 3; ++a) {
-      p[a] = base.p[a] + offset[a];
-      c[a] = base.c[a] + offset[a];
-    }
-    lo = base.lo + offset[axis];
-    hi = base.hi + offset[axis];
+    if (!moving) return;
+    pose = motion->pose_at(t);
+    pose.apply(base.p, p);
+    pose.apply(base.c, c);
+    lo = base.lo + pose.d[axis];
+    hi = base.hi + pose.d[axis];
     if (shape != Shape::mesh || !mesh) return;
-    const double w = std::sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2]);
-    angle = w * e;
-    // Rodrigues' rotation formula about the unit axis k through origin.
-    const double k[3] = {w > 0 ? omega[0] / w : 0, w > 0 ? omega[1] / w : 0, w > 0 ? omega[2] / w : 1};
-    const double cs = std::cos(angle), sn = std::sin(angle);
     const std::vector<double>& ref = mesh->vertices;
     verts.resize(ref.size());
-    for (std::size_t v = 0; v < ref.size(); v += 3) {
-      const double r[3] = {ref[v] - origin[0], ref[v + 1] - origin[1], ref[v + 2] - origin[2]};
-      const double kr = k[0] * r[0] + k[1] * r[1] + k[2] * r[2];
-      const double kxr[3] = {k[1] * r[2] - k[2] * r[1], k[2] * r[0] - k[0] * r[2], k[0] * r[1] - k[1] * r[0]};
-      for (int a = 0; a < 3; ++a)
-        verts[v + a] = origin[a] + offset[a] + r[a] * cs + kxr[a] * sn + k[a] * kr * (1.0 - cs);
-    }
+    for (std::size_t v = 0; v < ref.size(); v += 3) pose.apply(&ref[v], &verts[v]);
     triangle_bounds(*mesh, verts, tri_bounds);
   }
 
-  /// Velocity of the surface point (x, y, z) at time t: v + omega x (x - origin(t)).
-  void surface_velocity(double t, double x, double y, double z, double& ux, double& uy, double& uz) const {
-    if (!moving || t < motion_start || t >= motion_end) {
+  /// Velocity of the surface point (x, y, z) at the time of the last place().
+  void surface_velocity(double x, double y, double z, double& ux, double& uy, double& uz) const {
+    if (!moving) {
       ux = uy = uz = 0.0;
       return;
     }
-    const double rx = x - origin[0] - offset[0], ry = y - origin[1] - offset[1], rz = z - origin[2] - offset[2];
-    ux = velocity[0] + omega[1] * rz - omega[2] * ry;
-    uy = velocity[1] + omega[2] * rx - omega[0] * rz;
-    uz = velocity[2] + omega[0] * ry - omega[1] * rx;
+    const double xp[3] = {x, y, z};
+    double u[3];
+    pose.velocity(xp, u);
+    ux = u[0]; uy = u[1]; uz = u[2];
   }
 
   /// Distance `d` of the point from the surface (positive on the particle

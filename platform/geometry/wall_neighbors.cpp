@@ -43,11 +43,10 @@ void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double
     double rmax = 0;
     for (double r : s.radius) rmax = std::max(rmax, r);
     const double reach = rmax + skin;
-    if (!grid_valid_ || reach > grid_reach_ || grid_elapsed_ != built_elapsed || w.moving) {
+    if (!grid_valid_ || reach > grid_reach_ || w.moving) {
       grid_.build(w.verts, *w.mesh, reach);
       grid_valid_ = true;
       grid_reach_ = reach;
-      grid_elapsed_ = built_elapsed;
     }
     const TriangleMesh& m = *w.mesh;
     for (std::size_t k = 0; k < s.size(); ++k) {
@@ -105,7 +104,7 @@ void WallNeighbors::save(ArchiveWriter& w, const std::string& p) const {
   w.put(p + "triangle", triangle);
   w.put(p + "history", history);
   w.put(p + "touching", touching);
-  w.put_scalar(p + "built_elapsed", built_elapsed);
+  w.put_scalar(p + "built_time", built_time);
   w.put_scalar<std::uint8_t>(p + "built", built ? 1 : 0);
 }
 
@@ -115,7 +114,8 @@ void WallNeighbors::load(const ArchiveReader& r, const std::string& p) {
   r.get_into(p + "triangle", triangle);
   r.get_into(p + "history", history);
   r.get_into(p + "touching", touching);
-  built_elapsed = r.scalar<double>(p + "built_elapsed");
+  // a checkpoint written before motion lists: NaN, rebuilt at the first step
+  built_time = r.has(p + "built_time") ? r.scalar<double>(p + "built_time") : std::nan("");
   built = r.scalar<std::uint8_t>(p + "built") != 0;
   grid_valid_ = false;
   if (particle_id.size() != particle.size() || touching.size() != particle.size() ||

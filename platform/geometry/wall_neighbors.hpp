@@ -41,13 +41,13 @@ class WallNeighbors {
   std::vector<uint32_t> triangle;      ///< mesh walls: the candidate triangle of each entry
   std::vector<double> history;
   std::vector<uint8_t> touching;
-  double built_elapsed = 0.0;          ///< the wall's elapsed motion time at this build
+  double built_time = 0.0;             ///< the simulated time of the wall's placement at this build (NaN: unknown)
   bool built = false;                  ///< built while the wall was active
 
  private:
   TriangleGrid grid_;
   bool grid_valid_ = false;
-  double grid_reach_ = 0.0, grid_elapsed_ = -1.0;
+  double grid_reach_ = 0.0;
   std::vector<uint32_t> query_;
 };
 

@@ -168,8 +168,8 @@ void append_wall_surface(const WallPrimitive& w, const double lo[3], const doubl
         double q[4][3];
         for (int k = 0; k < 4; ++k) {
           q[k][a] = w.p[a];
-          q[k][b] = ((k == 1 || k == 2) ? w.draw_hi[b] : w.draw_lo[b]) + w.offset[b];
-          q[k][c] = (k >= 2 ? w.draw_hi[c] : w.draw_lo[c]) + w.offset[c];
+          q[k][b] = ((k == 1 || k == 2) ? w.draw_hi[b] : w.draw_lo[b]) + w.pose.d[b];
+          q[k][c] = (k >= 2 ? w.draw_hi[c] : w.draw_lo[c]) + w.pose.d[c];
         }
         add_polygon(out,
                     {add_point(out, q[0][0], q[0][1], q[0][2]), add_point(out, q[1][0], q[1][1], q[1][2]),
@@ -216,7 +216,7 @@ fs::path WallSurfaceSeries::write(double time, const std::vector<WallPrimitive>&
     append_wall_surface(w, lo, hi, s);
     for (std::size_t k = first; k < s.points.size(); k += 3) {
       double u[3];
-      w.surface_velocity(time, s.points[k], s.points[k + 1], s.points[k + 2], u[0], u[1], u[2]);
+      w.surface_velocity(s.points[k], s.points[k + 1], s.points[k + 2], u[0], u[1], u[2]);
       velocity.insert(velocity.end(), u, u + 3);
     }
   }

@@ -77,6 +77,31 @@ void build_walls(Build& b) {
     b.sim.wall_names.push_back(w["name"].get<std::string>());
     try {
       auto prims = expand_wall(w, k, b.mat_index.at(w["material"].get<std::string>()), b.file);
+      // a servo (one per wall, validated): its controller, and its wall's load summed
+      const MotionItem* servo_item = nullptr;
+      if (!prims.empty() && prims[0].moving)
+        for (const MotionItem& it : prims[0].motion->items)
+          if (it.kind == MotionItem::Kind::servo) servo_item = &it;
+      if (servo_item) {
+        const json& mo = w["motion"];
+        for (const json& item : mo.is_array() ? mo : json::array({mo})) {
+          const json* sv = member(item, "servo");
+          if (!sv) continue;
+          WallServo s;
+          s.name = w["name"].get<std::string>();
+          s.wall = k;
+          for (int a = 0; a < 3; ++a) s.direction[a] = servo_item->vec[a];
+          s.force = (*sv)["force"].get<double>();
+          const double vmax = (*sv)["max_velocity"].get<double>();
+          s.gain = sv->contains("gain") ? (*sv)["gain"].get<double>() : vmax / s.force;
+          s.start = servo_item->start;
+          s.end = servo_item->end;
+          s.state = servo_item->servo;
+          s.state->max_velocity = vmax;
+          b.sim.servos.servos.push_back(std::move(s));
+        }
+        for (auto& p : prims) p.track_load = true;
+      }
       b.sim.walls.insert(b.sim.walls.end(), prims.begin(), prims.end());
     } catch (const MeshError& e) {  // the file changed since validation
       b.ck.add("/walls", e.what());
@@ -89,7 +114,29 @@ void build_walls(Build& b) {
 void build_run(Build& b) {
   const json& run = b.doc["run"];
   b.sim.name = b.doc.contains("name") ? b.doc["name"].get<std::string>() : b.file.stem().string();
-  for (int a = 0; a < 3; ++a) b.sim.gravity[a] = b.doc["gravity"][a].get<double>();
+  const json& g = b.doc["gravity"];
+  GravitySchedule schedule;
+  if (g.is_array()) {
+    double v[3];
+    for (int a = 0; a < 3; ++a) v[a] = g[a].get<double>();
+    schedule = GravitySchedule::constant(v);
+  } else if (g.contains("table")) {
+    std::vector<std::array<double, 4>> rows;
+    for (const json& r : g["table"]) rows.push_back({r[0].get<double>(), r[1].get<double>(), r[2].get<double>(), r[3].get<double>()});
+    schedule = GravitySchedule::table(std::move(rows));
+  } else {
+    const json& rot = g["rotation"];
+    double v[3], axis[3];
+    for (int a = 0; a < 3; ++a) {
+      v[a] = g["vector"][a].get<double>();
+      axis[a] = rot["axis"][a].get<double>();
+    }
+    schedule = GravitySchedule::rotating(v, axis, rot["rate"].get<double>(), rot["start"].get<double>(),
+                                         rot.contains("end") ? rot["end"].get<double>()
+                                                             : std::numeric_limits<double>::infinity());
+  }
+  schedule.at(0.0, b.sim.gravity);
+  if (schedule.varies()) b.sim.gravity_schedule = std::make_shared<const GravitySchedule>(std::move(schedule));
   b.sim.seed = run["seed"].get<std::uint64_t>();
   // no schema default: absent means $DOMEL_THREADS, else 1, decided at run time (Simulation::run)
   b.sim.threads = run.contains("threads") ? run["threads"].get<int>() : 0;
@@ -459,6 +506,7 @@ void build_subdomain(Build& b, std::size_t k) {
     }
   }
   sub->set_environment(b.sim.materials, &b, coefficients_of, &b.sim.walls, b.sim.gravity);
+  if (b.sim.gravity_schedule) sub->set_gravity(b.sim.gravity_schedule);
 
   const std::size_t problems_before_insert = b.ck.diags.size();
   build_initial_state(b, *sub, sd, base);
@@ -580,6 +628,13 @@ void build_particle_flow(Build& b) {
   flow.register_hooks(b.sim.hooks);
 }
 
+/// The first rotation of scenario wall `wall`'s motion (null if it does not rotate).
+const MotionItem* first_rotation_of(const std::vector<WallPrimitive>& walls, std::size_t wall) {
+  for (const WallPrimitive& q : walls)
+    if (q.wall == wall) return q.moving ? q.motion->first_rotation() : nullptr;
+  return nullptr;
+}
+
 /// output.wall_loads (the probes and their torque axes) and output.contacts;
 /// the contact files' interval is resolved by build_outputs().
 void build_contact_outputs(Build& b) {
@@ -620,15 +675,10 @@ void build_contact_outputs(Build& b) {
           continue;
         }
         set_axis((*ax)["point"], dir);
-      } else if (const json* mo = member(w, "motion");
-                 mo && ((*mo)["angular_velocity"][0].get<double>() != 0 ||
-                        (*mo)["angular_velocity"][1].get<double>() != 0 ||
-                        (*mo)["angular_velocity"][2].get<double>() != 0)) {
-        // the rotation axis, through the motion's origin (the default origin as WallPrimitive has it)
-        const WallPrimitive& prim = *std::find_if(b.sim.walls.begin(), b.sim.walls.end(),
-                                                  [&](const WallPrimitive& q) { return q.wall == p.wall; });
-        for (int a = 0; a < 3; ++a) dir[a] = prim.omega[a];
-        const json origin = {prim.origin[0], prim.origin[1], prim.origin[2]};
+      } else if (const MotionItem* rot = first_rotation_of(b.sim.walls, p.wall)) {
+        // the (first) rotation's axis, through its origin (the default origin as the motion has it)
+        for (int a = 0; a < 3; ++a) dir[a] = rot->vec[a];
+        const json origin = {rot->origin[0], rot->origin[1], rot->origin[2]};
         set_axis(origin, dir);
       } else if (type == "cylinder" || type == "cone") {
         dir[axis_index(&w["axis"])] = 1.0;

@@ -186,6 +186,10 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
                              {"interaction", "Interaction (`interactions[]`)"},
                              {"wall", "Wall (`walls[]`)"},
                              {"wall_motion", "Wall motion (`walls[].motion`)"},
+                             {"wall_vibration", "Wall vibration (`walls[].motion.vibration`)"},
+                             {"wall_servo", "Servo wall (`walls[].motion.servo`)"},
+                             {"gravity_table", "Gravity over time: a table (`gravity`)"},
+                             {"gravity_rotation", "Gravity over time: a rotation (`gravity`)"},
                              {"region", "Region (`insert[].region`)"},
                              {"subdomain", "Subdomain (`subdomains[]`)"},
                              {"contact", "Contact model (`subdomains[].contact`)"},
@@ -224,7 +228,8 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
       std::vector<const char*> members;
     } nested[] = {{"coupling", "couplings[].", {"region", "stress_control", "velocity_control"}},
                   {"output", "output.", {"repose_angle", "contacts"}},
-                  {"wall_load", "output.wall_loads[].", {"axis"}}};
+                  {"wall_load", "output.wall_loads[].", {"axis"}},
+                  {"gravity_rotation", "gravity.", {"rotation"}}};
     for (const auto& n : nested) {
       if (std::string(b[0]) != n.block) continue;
       for (const char* sub : n.members) {

@@ -319,14 +319,39 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
                                             : "paths in \"file\" are relative to the scenario's folder");
         }
       }
-      if (const json* mo = member(w, "motion"); mo && mo->is_object()) {
-        const json* st = member(*mo, "start");
-        const json* en = member(*mo, "end");
-        if (st && en && st->is_number() && en->is_number() && en->get<double>() <= st->get<double>())
-          ck.add(base + "/motion/end", "expected end > start, found end " + fmt_num(en->get<double>()) +
-                                           " <= start " + fmt_num(st->get<double>()));
-        const json* om = member(*mo, "angular_velocity");
-        if (is_vec3(om) && t != "mesh") {
+      if (const json* mo = member(w, "motion"); mo && (mo->is_object() || mo->is_array())) {
+        const json items = mo->is_array() ? *mo : json::array({*mo});
+        int servos = 0;
+        for (std::size_t i = 0; i < items.size(); ++i) {
+          const json& m = items[i];
+          if (!m.is_object()) continue;
+          const std::string mp = base + "/motion" + (mo->is_array() ? "/" + std::to_string(i) : std::string());
+          const json* st = member(m, "start");
+          const json* en = member(m, "end");
+          if (st && en && st->is_number() && en->is_number() && en->get<double>() <= st->get<double>())
+            ck.add(mp + "/end", "expected end > start, found end " + fmt_num(en->get<double>()) + " <= start " +
+                                    fmt_num(st->get<double>()));
+          if (const json* sv = member(m, "servo")) {
+            if (++servos == 2)
+              ck.add(mp + "/servo", "expected one servo per wall, found a second one",
+                     "a wall holds one target force; give the other servo its own wall");
+            auto given = [&](const char* k) {
+              const json* v = member(m, k);
+              if (!v) return false;
+              if (!is_vec3(v)) return true;
+              return (*v)[0].get<double>() != 0 || (*v)[1].get<double>() != 0 || (*v)[2].get<double>() != 0;
+            };
+            for (const char* other : {"velocity", "angular_velocity", "vibration"})
+              if (given(other))
+                ck.add(mp + "/" + other, std::string("a servo item moves the wall only along its direction, found \"") +
+                                             other + "\" beside it",
+                       "put the " + std::string(other) + " in an item of its own in a motion list");
+            if (const json* dir = member(*sv, "direction"); is_vec3(dir) && (*dir)[0].get<double>() == 0 &&
+                                                            (*dir)[1].get<double>() == 0 && (*dir)[2].get<double>() == 0)
+              ck.add(mp + "/servo/direction", "expected a non-zero direction, found [0, 0, 0]");
+          }
+          const json* om = member(m, "angular_velocity");
+          if (!is_vec3(om) || t == "mesh") continue;
           const double wv[3] = {(*om)[0].get<double>(), (*om)[1].get<double>(), (*om)[2].get<double>()};
           const double wl = std::sqrt(wv[0] * wv[0] + wv[1] * wv[1] + wv[2] * wv[2]);
           // the wall's own axis: the normal of a plane or disk, the axis of a cylinder or cone
@@ -340,35 +365,50 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
             have_axis = true;
           }
           const double al = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
-          auto cross_norm = [](const double* a, const double* b) {
-            const double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-            return std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-          };
+          const double c[3] = {wv[1] * ax[2] - wv[2] * ax[1], wv[2] * ax[0] - wv[0] * ax[2], wv[0] * ax[1] - wv[1] * ax[0]};
           if (wl > 0 && t == "box") {
-            ck.add(base + "/motion/angular_velocity", "a box wall cannot rotate, found a non-zero angular_velocity",
+            ck.add(mp + "/angular_velocity", "a box wall cannot rotate, found a non-zero angular_velocity",
                    "use a mesh wall for a rotating box, or only a velocity");
-          } else if (wl > 0 && have_axis && al > 0 && cross_norm(wv, ax) > 1e-9 * wl * al) {
-            ck.add(base + "/motion/angular_velocity",
-                   "a " + t + " wall rotates only about its own " + (t == "plane" || t == "disk" ? "normal" : "axis") +
-                       ", found angular_velocity [" + fmt_num(wv[0]) + ", " + fmt_num(wv[1]) + ", " + fmt_num(wv[2]) +
-                       "] not parallel to it",
+          } else if (wl > 0 && have_axis && al > 0 &&
+                     std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) > 1e-9 * wl * al) {
+            ck.add(mp + "/angular_velocity",
+                   "a " + t + " wall rotates only about an axis parallel to its own " +
+                       (t == "plane" || t == "disk" ? "normal" : "axis") + ", found angular_velocity [" +
+                       fmt_num(wv[0]) + ", " + fmt_num(wv[1]) + ", " + fmt_num(wv[2]) + "] not parallel to it",
                    "use a mesh wall for other rotations");
-          } else if (wl > 0 && have_axis && al > 0 && is_vec3(member(*mo, "origin"))) {
-            const char* ref = t == "plane" ? "point" : "center";
-            if (is_vec3(member(w, ref))) {
-              double d[3];
-              for (int a = 0; a < 3; ++a) d[a] = (*mo)["origin"][a].get<double>() - w[ref][a].get<double>();
-              const double dl = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-              if (cross_norm(d, ax) > 1e-9 * al * std::max(1.0, dl))
-                ck.add(base + "/motion/origin",
-                       "a " + t + " wall rotates only about its own axis, found an origin off the axis through its " +
-                           ref,
-                       "omit origin, or use a mesh wall for an eccentric rotation");
-            }
           }
         }
       }
     }
+  }
+
+  // gravity over time
+  if (const json* g = member(doc, "gravity"); g && g->is_object()) {
+    if (const json* tab = member(*g, "table"); tab && tab->is_array()) {
+      for (std::size_t i = 1; i < tab->size(); ++i) {
+        const json& r0 = (*tab)[i - 1];
+        const json& r1 = (*tab)[i];
+        if (r0.is_array() && r1.is_array() && !r0.empty() && !r1.empty() && r0[0].is_number() &&
+            r1[0].is_number() && r1[0].get<double>() <= r0[0].get<double>())
+          ck.add("/gravity/table/" + std::to_string(i) + "/0",
+                 "expected times strictly increasing, found " + fmt_num(r1[0].get<double>()) + " after " +
+                     fmt_num(r0[0].get<double>()));
+      }
+    }
+    if (const json* ax = member(*g, "rotation"); ax && is_vec3(member(*ax, "axis")) &&
+                                                 (*ax)["axis"][0].get<double>() == 0 &&
+                                                 (*ax)["axis"][1].get<double>() == 0 &&
+                                                 (*ax)["axis"][2].get<double>() == 0)
+      ck.add("/gravity/rotation/axis", "expected a non-zero axis, found [0, 0, 0]");
+    if (const json* rot = member(*g, "rotation")) {
+      const json* st = member(*rot, "start");
+      const json* en = member(*rot, "end");
+      if (en && en->is_number() && en->get<double>() <= (st && st->is_number() ? st->get<double>() : 0.0))
+        ck.add("/gravity/rotation/end", "expected end > start, found end " + fmt_num(en->get<double>()));
+    }
+    if (doc.contains("fluid"))
+      ck.add("/gravity", "a fluid block needs a constant gravity, found one that changes with time",
+             "give gravity as a vector");
   }
 
   // subdomains

@@ -199,20 +199,53 @@ std::vector<WallPrimitive> expand_wall(const json& w, std::size_t wall_index, st
     for (auto& p : out) p.remove_at = std::min(p.remove_at, w["remove_at"].get<double>());
   if (const json* mo = member(w, "motion")) {
     const std::string type = w["type"].get<std::string>();
-    for (auto& p : out) {
-      p.moving = true;
-      for (int a = 0; a < 3; ++a) {
-        p.velocity[a] = (*mo)["velocity"][a].get<double>();
-        p.omega[a] = (*mo)["angular_velocity"][a].get<double>();
+    auto motion = std::make_shared<WallMotion>();
+    auto vec = [](const json& v, double out[3]) {
+      for (int a = 0; a < 3; ++a) out[a] = v[a].get<double>();
+    };
+    auto unit = [](double v[3]) {
+      const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (int a = 0; a < 3; ++a) v[a] /= l;
+    };
+    const json items = mo->is_array() ? *mo : json::array({*mo});
+    for (const json& m : items) {
+      MotionItem base;
+      base.start = m["start"].get<double>();
+      if (m.contains("end")) base.end = m["end"].get<double>();
+      // within one item: the rotation, then the translation, the vibration, the servo
+      MotionItem rot = base;
+      rot.kind = MotionItem::Kind::rotation;
+      vec(m["angular_velocity"], rot.vec);
+      for (int a = 0; a < 3; ++a)
         // default origin: the wall's own centre or point (on its rotation axis), 0 for a mesh
-        p.origin[a] = mo->contains("origin") ? (*mo)["origin"][a].get<double>()
-                      : type == "plane"      ? w["point"][a].get<double>()
-                      : w.contains("center") ? w["center"][a].get<double>()
-                                             : 0.0;
+        rot.origin[a] = m.contains("origin")     ? m["origin"][a].get<double>()
+                        : type == "plane"        ? w["point"][a].get<double>()
+                        : w.contains("center")   ? w["center"][a].get<double>()
+                                                 : 0.0;
+      if (rot.vec[0] != 0 || rot.vec[1] != 0 || rot.vec[2] != 0) motion->items.push_back(rot);
+      MotionItem tr = base;
+      tr.kind = MotionItem::Kind::translation;
+      vec(m["velocity"], tr.vec);
+      if (tr.vec[0] != 0 || tr.vec[1] != 0 || tr.vec[2] != 0) motion->items.push_back(tr);
+      if (const json* vib = member(m, "vibration")) {
+        MotionItem v = base;
+        v.kind = MotionItem::Kind::vibration;
+        vec((*vib)["amplitude"], v.vec);
+        v.omega_f = 2.0 * M_PI * (*vib)["frequency"].get<double>();
+        v.phase = (*vib)["phase"].get<double>();
+        motion->items.push_back(v);
       }
-      p.motion_start = (*mo)["start"].get<double>();
-      if (mo->contains("end")) p.motion_end = (*mo)["end"].get<double>();
+      if (const json* sv = member(m, "servo")) {
+        MotionItem v = base;
+        v.kind = MotionItem::Kind::servo;
+        vec((*sv)["direction"], v.vec);
+        unit(v.vec);
+        v.servo = std::make_shared<ServoState>();
+        v.servo->t_ref = base.start;
+        motion->items.push_back(v);
+      }
     }
+    for (auto& p : out) p.set_motion(motion);
   }
   return out;
 }

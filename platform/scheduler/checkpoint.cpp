@@ -201,6 +201,8 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
 
 bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim) {
   bool same_split = true;
+  // the servos' travel first: the subdomains place their walls with it
+  if (!sim.servos.empty()) sim.servos.load(*ck.archive, "servos/");
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k)
     same_split = sim.subdomains[k]->restore(*ck.archive, sd_prefix(k)) && same_split;
   sim.flow.restore(*ck.archive, "flow/", sim.subdomains);

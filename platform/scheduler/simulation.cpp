@@ -101,6 +101,8 @@ std::string probe_column_unit(const std::string& column) {
   if (name == "rate_kg_s") return "kg/s";
   if (name == "force_x" || name == "force_y" || name == "force_z") return "N";  // output.wall_loads
   if (name == "torque") return "N m";
+  if (name == "servo_force") return "N";  // walls[].motion[].servo
+  if (name == "servo_travel") return "m";
   return "";
 }
 
@@ -182,6 +184,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   }
   for (const auto& c : flow.columns()) columns.push_back(c);
   for (const auto& c : contact_sample.columns()) columns.push_back(c);
+  for (const auto& c : servos.columns()) columns.push_back(c);
   if (!ck) flow.start(subdomains);
 
   // Cell grids: accessible volume from the walls present at the start.
@@ -250,6 +253,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       for (auto& c : couplings) c->exchange(step.t, subdomains, walls, flow);
     });
   }
+  // Servo walls: the loads of the macro step's last force evaluation set
+  // the velocities of the next one.
+  if (!servos.empty())
+    run_hooks.after.push_back([this](const MacroStep& step) { servos.update(step.t, subdomains); });
   // The fluid exchange: all levels stand at the same time at a macro-step start.
   if (fluid)
     run_hooks.before.push_back([this](const MacroStep& step) {
@@ -315,6 +322,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     flow.check_planes(subdomains);
     flow.append_row(t, row);
     contact_sample.append_values(t, kTimeTolerance * macro, row);
+    servos.append_values(t, row);
     probes->append(row);
   };
   auto write_vtk = [&](double t) {
@@ -408,6 +416,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       for (std::size_t k = 0; k < couplings.size(); ++k) couplings[k]->save(w, "coupling" + std::to_string(k) + "/");
       if (fluid) fluid->save(w, "fluid/");
       if (contact_sample.enabled()) contact_sample.save(w, "contacts/");
+      if (!servos.empty()) servos.save(w, "servos/");
       if (contact_vtk) {
         w.put_scalar("contacts/frames", contact_frames.index());
         w.put_scalar("contacts/period", contact_frames.period());

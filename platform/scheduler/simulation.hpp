@@ -14,6 +14,7 @@
 #include "scheduler/contact_sample.hpp"
 #include "scheduler/particle_flow.hpp"
 #include "scheduler/schedule.hpp"
+#include "scheduler/servo.hpp"
 #include "subdomain/repose_probe.hpp"
 #include "subdomain/subdomain.hpp"
 
@@ -75,7 +76,9 @@ class Simulation {
   std::vector<std::string> wall_names;  ///< the scenario walls (WallPrimitive::wall indexes it)
   std::vector<std::unique_ptr<Subdomain>> subdomains;
   std::vector<TimeStepReport> time_steps;  ///< per subdomain
-  double gravity[3] = {0, 0, 0};  ///< [m/s^2] the scenario's (its schema default when omitted)
+  double gravity[3] = {0, 0, 0};  ///< [m/s^2] the scenario's at t = 0 (its schema default when omitted)
+  std::shared_ptr<const GravitySchedule> gravity_schedule;  ///< the scenario's gravity over time (core/gravity.hpp)
+  WallServos servos;  ///< walls[].motion[].servo (scheduler/servo.hpp): updated after every macro step
   double duration = 0;
   double checkpoint_interval = 0;  ///< [s] run.checkpoint_interval; 0: none
   nlohmann::json document;         ///< the validated scenario, defaults filled (checkpoints compare it)

@@ -75,6 +75,21 @@ void Subdomain::add_hook(Phase phase, StepHook hook) {
   hooks_.add(phase, std::move(hook));
 }
 
+void Subdomain::set_gravity(std::shared_ptr<const GravitySchedule> g) {
+  synchronize();
+  if (g) g->at(time_, body_forces_.gravity);
+  gravity_ = g && g->varies() ? std::move(g) : nullptr;
+}
+
+void Subdomain::wall_load(std::size_t wall, double f[3]) const {
+  synchronize_logically_const();  // the deferred wall contacts
+  f[0] = f[1] = f[2] = 0.0;
+  for (const auto& ts : scratch_)
+    for (std::size_t w = 0; w < walls_now_.size() && 3 * w + 2 < ts.wall_load.size(); ++w)
+      if (walls_now_[w].wall == wall && walls_now_[w].track_load)
+        for (int a = 0; a < 3; ++a) f[a] -= ts.wall_load[3 * w + a];  // the sums are the forces on the particles
+}
+
 void Subdomain::apply_body_forces(std::size_t first, std::size_t last) {
   synchronize();
   body_forces_.apply(store_, first, last);
@@ -96,6 +111,7 @@ void Subdomain::setup() {
   nlist_.configure(skin_, stride);
   update_walls(time_);
   rebuild_lists();
+  if (gravity_) gravity_->at(time_, body_forces_.gravity);
   const std::size_t n = store_.size();
   pool_->for_range(n, [&](std::size_t first, std::size_t last, int) { body_forces_.apply(store_, first, last); });
   try {
@@ -148,7 +164,7 @@ void Subdomain::rebuild_lists() {
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     const WallPrimitive& wall = walls_now_[w];
     wall_lists_[w].build(store_, wall, skin_, pipeline_->history_stride(), wall.active(time_));
-    wall_lists_[w].built_elapsed = wall.elapsed(wall_time_);
+    wall_lists_[w].built_time = wall_time_;
   }
 }
 
@@ -166,10 +182,10 @@ void Subdomain::update_walls(double t) {
       list.clear();
       if (active) {
         list.build(store_, wall, skin_, stride, true);
-        list.built_elapsed = wall.elapsed(t);
+        list.built_time = t;
       }
     } else if (active && wall.moving &&
-               wall.displacement_bound(list.built_elapsed, wall.elapsed(t)) > 0.5 * skin_) {
+               (std::isnan(list.built_time) || wall.displacement_bound(list.built_time, t) > 0.5 * skin_)) {
       // The wall moved half the skin since its list was built. Rebuilding this
       // list alone would not do: a particle may by now have moved up to half
       // the skin from where the last full build saw it, and may move another
@@ -227,6 +243,7 @@ std::pair<std::size_t, std::size_t> Subdomain::finish_forces(int t, bool reduce,
   ContactScratch& ts = scratch_[static_cast<std::size_t>(t)];
   ts.wall_contacts = 0;
   ts.wall_max_ratio = 0.0;
+  std::fill(ts.wall_load.begin(), ts.wall_load.end(), 0.0);
   wall_range(wall_sweep(), ts, first, last);
   return {first, last};
 }
@@ -289,6 +306,7 @@ void Subdomain::step_fused() {
   const bool stale = nlist_.layout_stale(store_);
   const bool finish = kick_pending_;
   kick_pending_ = false;
+  if (gravity_) gravity_->at(time_ + dt, body_forces_.gravity);  // the reset below is to the forces at t + dt
   try {
     const bool reduce = take_pending_reduce(n);  // pending only with a pending kick
     const KickDrift how{dt, half, pending_half_, finish, stale ? nullptr : &nlist_, &body_forces_};
@@ -352,6 +370,7 @@ void Subdomain::step_in_order() {
   }
   run_hooks(Phase::ghost_update);
   // body_force: after the exchange, so that particles it brought get theirs
+  if (gravity_) gravity_->at(time_ + dt, body_forces_.gravity);
   pool_->for_range(store_.size(),
                    [&](std::size_t first, std::size_t last, int) { body_forces_.apply(store_, first, last); });
   run_hooks(Phase::body_force);
@@ -456,6 +475,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
 
 void Subdomain::wall_forces() {
   prune_removed_walls();
+  for (auto& other : scratch_) std::fill(other.wall_load.begin(), other.wall_load.end(), 0.0);
   ContactScratch& ts = scratch_[0];
   ts.wall_contacts = 0;
   ts.wall_max_ratio = 0.0;
@@ -552,6 +572,7 @@ bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
   walls_force_rebuild_ = counters[6] != 0;
   for (std::size_t w = 0; w < walls_now_.size(); ++w)
     if (walls_now_[w].moving) walls_now_[w].place((*walls_)[w], wall_time_);
+  if (gravity_) gravity_->at(time_, body_forces_.gravity);  // the loaded forces' time
   kick_pending_ = false;
   reduce_pending_ = false;
   contacts_counted_ = true;

@@ -12,6 +12,7 @@
 // operators exchange cell averages between them through hooks.
 #pragma once
 
+#include "core/gravity.hpp"
 #include "averaging/cell_grid.hpp"
 #include "contact/contact_pipeline.hpp"
 #include "contact/contact_sweep.hpp"
@@ -96,6 +97,14 @@ class Subdomain {
   /// of a particle of local material a with wall primitive w.
   const domel_pair_v2& pair(std::size_t a, std::size_t b) const { return pairs_[a * materials_.size() + b]; }
   const domel_pair_v2& wall_pair(std::size_t w, std::size_t a) const { return wall_pairs_[w * materials_.size() + a]; }
+
+  /// Gravity that changes with time (core/gravity.hpp): read once per step
+  /// for the forces at the step's end. Without one, gravity stays the
+  /// vector given to set_environment().
+  void set_gravity(std::shared_ptr<const GravitySchedule> g);
+  /// The force [N] the particles put on scenario wall `wall` at the last
+  /// force evaluation: the sum over its primitives with track_load set.
+  void wall_load(std::size_t wall, double f[3]) const;
 
   /// The body-force list (gravity; the store's external forces once enabled).
   const BodyForces& body_forces() const { return body_forces_; }
@@ -210,6 +219,7 @@ class Subdomain {
   std::vector<domel_pair_v2> pairs_;       ///< [a * n + b], n = materials_.size()
   std::vector<domel_pair_v2> wall_pairs_;  ///< [w * n + a]
   BodyForces body_forces_;
+  std::shared_ptr<const GravitySchedule> gravity_;  ///< null: constant gravity
   StepHooks hooks_;
   double skin_ = 0;
   double dt_ = 0;

@@ -119,10 +119,8 @@ TEST(WallSurfaces, AnAnnulusIsARingBetweenItsRadiiAndAContainerBottomADisk) {
 
 TEST(WallSurfaces, AMovingWallIsWrittenWhereItsMotionTookItWithItsSurfaceVelocity) {
   dp::WallPrimitive w = cylinder();  // translating along x at 0.2 m/s, turning about its axis at 3 rad/s
-  w.moving = true;
-  w.velocity[0] = 0.2;
-  w.omega[2] = 3.0;
-  for (int a = 0; a < 3; ++a) w.origin[a] = w.c[a];
+  const double vel[3] = {0.2, 0, 0}, om[3] = {0, 0, 3.0};
+  w.set_motion(std::make_shared<dp::WallMotion>(dp::WallMotion::constant(vel, om, w.c, 0.0)));
   dp::WallPrimitive gone = cylinder();  // removed before the frame: not drawn
   gone.remove_at = 0.5;
   const fs::path dir = fs::temp_directory_path() / ("domel_wall_surfaces_" + std::to_string(getpid()));

@@ -184,6 +184,26 @@ TEST(Checkpoint, WallLoadsContactAndWallFilesRestartedAreBitIdentical) {
   for (int threads : {1, 2}) expect_restart_identical(hopper_with_loads(), "hopper_loads", 20000, 0.03, threads);
 }
 
+json shaken() {
+  // settle() in a box vibrating along z (a motion list: a translation to
+  // 5 ms, then the vibration), under a servo lid, with gravity tilting about x
+  json d = settle();
+  d["walls"][0]["motion"] = json::array({{{"velocity", {0, 0, 0.01}}, {"end", 0.005}},
+                                         {{"vibration", {{"amplitude", {0, 0, 5e-4}}, {"frequency", 30}}}, {"start", 0.005}}});
+  d["walls"].push_back({{"name", "lid"}, {"type", "plane"}, {"material", "beads"}, {"point", {0, 0, 0.057}},
+                        {"normal", {0, 0, -1}},
+                        {"motion", {{"servo", {{"direction", {0, 0, -1}}, {"force", 0.5}, {"max_velocity", 0.05}}}}}});
+  d["gravity"] = {{"vector", {0, 0, -9.81}}, {"rotation", {{"axis", {1, 0, 0}}, {"rate", 0.5}, {"start", 0.01}}}};
+  d["output"]["probe_interval"] = 0.001;
+  return d;
+}
+
+TEST(Checkpoint, ShakenBoxUnderAServoLidWithTiltingGravityRestartedIsBitIdentical) {
+  // stopped while the box vibrates, the lid presses (from 0.015 s) and gravity turns: the
+  // servo's travel and velocity and the walls' lists continue
+  for (int threads : {1, 2}) expect_restart_identical(shaken(), "shaken", 2345, 0.007, threads);
+}
+
 TEST(Checkpoint, SettleRestartedIsBitIdentical) {
   for (int threads : {1, 2}) expect_restart_identical(settle(), "settle", 2345, 0.007, threads);
 }

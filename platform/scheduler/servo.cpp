@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: MIT
+#include "scheduler/servo.hpp"
+
+#include "core/archive.hpp"
+#include "subdomain/subdomain.hpp"
+
+#include <algorithm>
+
+namespace domel::platform {
+
+void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  for (WallServo& s : servos) {
+    double f[3] = {0, 0, 0};
+    for (const auto& sd : subdomains) {
+      double g[3];
+      sd->wall_load(s.wall, g);
+      for (int a = 0; a < 3; ++a) f[a] += g[a];
+    }
+    // the particles push the wall back against its direction
+    s.measured = 0.0 - (f[0] * s.direction[0] + f[1] * s.direction[1] + f[2] * s.direction[2]);
+    const double vmax = s.state->max_velocity;
+    const double v = t >= s.start && t < s.end ? std::clamp(s.gain * (s.force - s.measured), -vmax, vmax) : 0.0;
+    s.state->set_velocity(t, v);
+  }
+}
+
+std::vector<std::string> WallServos::columns() const {
+  std::vector<std::string> c;
+  for (const WallServo& s : servos) {
+    c.push_back(s.name + ".servo_force");
+    c.push_back(s.name + ".servo_travel");
+  }
+  return c;
+}
+
+void WallServos::append_values(double t, std::vector<double>& row) const {
+  for (const WallServo& s : servos) {
+    row.push_back(s.measured);
+    row.push_back(s.state->travel(std::clamp(t, s.start, s.end)));
+  }
+}
+
+void WallServos::save(ArchiveWriter& w, const std::string& prefix) const {
+  std::vector<double> v;
+  for (const WallServo& s : servos)
+    v.insert(v.end(), {s.state->s_ref, s.state->t_ref, s.state->velocity, s.measured});
+  w.put(prefix + "state", v);
+}
+
+void WallServos::load(const ArchiveReader& r, const std::string& prefix) {
+  const std::vector<double> v = r.get<double>(prefix + "state");
+  if (v.size() != 4 * servos.size())
+    r.fail(prefix + "state", "holds " + std::to_string(v.size() / 4) + " servos, this scenario has " +
+                                 std::to_string(servos.size()));
+  for (std::size_t k = 0; k < servos.size(); ++k) {
+    servos[k].state->s_ref = v[4 * k];
+    servos[k].state->t_ref = v[4 * k + 1];
+    servos[k].state->velocity = v[4 * k + 2];
+    servos[k].measured = v[4 * k + 3];
+  }
+}
+
+}  // namespace domel::platform
