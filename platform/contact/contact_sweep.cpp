@@ -136,7 +136,7 @@ void group_by_key(uint32_t c, uint32_t n_keys, KeyOf&& key, std::vector<uint32_t
   for (uint32_t q = 0; q < c; ++q) slot_of[q] = count[slot_of[q]]++;
 }
 
-template <bool kZoned, bool kTorque, bool kMasses, bool kMixed>
+template <bool kZoned, bool kTorque, bool kMasses, bool kMixed, bool kPeriodic>
 void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, ContactScratch& ts, std::size_t own_lo,
                 std::size_t own_hi, const ForceAccumulator& own, const ForceAccumulator& shared) {
   const ParticleStore& s = *sw.store;
@@ -167,6 +167,17 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
   const auto zone_lo = static_cast<uint32_t>(own_lo);
   const auto zone_width = static_cast<uint32_t>(own_hi - own_lo);
   const ForceAccumulator own_acc = own, shared_acc = shared;
+  // periodic boundaries: the separation to the nearest image (core/neighbor_list.hpp)
+  double per[3] = {0, 0, 0}, inv_per[3] = {0, 0, 0};
+  if constexpr (kPeriodic) list.periodic().periods(per, inv_per);
+  auto separation = [&](uint32_t i, uint32_t j, double& dx, double& dy, double& dz) {
+    dx = px[i] - px[j]; dy = py[i] - py[j]; dz = pz[i] - pz[j];
+    if constexpr (kPeriodic) {
+      dx = min_image(dx, per[0], inv_per[0]);
+      dy = min_image(dy, per[1], inv_per[1]);
+      dz = min_image(dz, per[2], inv_per[2]);
+    }
+  };
 
   std::size_t e = first;
   while (e < last) {
@@ -177,7 +188,8 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     uint32_t c = 0;
     for (; e < last && c < kBatch; ++e) {
       const uint32_t i = li[e], j = lj[e];
-      const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
+      double dx, dy, dz;
+      separation(i, j, dx, dy, dz);
       const double rsum = pr[i] + pr[j];
       const uint32_t in = (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
       if (touching[e] > in) {  // the contact opened: its history ends
@@ -206,7 +218,8 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       if constexpr (kMixed) sl = slot_of[q];
       const uint32_t i = li[le], j = lj[le];
       const double ri = pr[i], rj = pr[j];
-      const double dx = px[i] - px[j], dy = py[i] - py[j], dz = pz[i] - pz[j];
+      double dx, dy, dz;
+      separation(i, j, dx, dy, dz);
       const double rsum = ri + rj, inv_rsum = 1.0 / rsum;
       const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
       const double inv = 1.0 / dist;
@@ -286,19 +299,24 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
 }  // namespace
 
 namespace {
-template <bool kMasses, bool kMixed>
+template <bool kMasses, bool kMixed, bool kPeriodic>
 PairRangeFn pair_kernel_of(bool has_torque, bool zoned) {
-  if (has_torque) return zoned ? &pair_range<true, true, kMasses, kMixed> : &pair_range<false, true, kMasses, kMixed>;
-  return zoned ? &pair_range<true, false, kMasses, kMixed> : &pair_range<false, false, kMasses, kMixed>;
+  if (has_torque)
+    return zoned ? &pair_range<true, true, kMasses, kMixed, kPeriodic> : &pair_range<false, true, kMasses, kMixed, kPeriodic>;
+  return zoned ? &pair_range<true, false, kMasses, kMixed, kPeriodic> : &pair_range<false, false, kMasses, kMixed, kPeriodic>;
+}
+template <bool kPeriodic>
+PairRangeFn pair_kernel_periodic(const ContactPipeline& pipeline, bool zoned, bool mixed) {
+  if (mixed)
+    return pipeline.reads_masses() ? pair_kernel_of<true, true, kPeriodic>(pipeline.has_torque(), zoned)
+                                   : pair_kernel_of<false, true, kPeriodic>(pipeline.has_torque(), zoned);
+  return pipeline.reads_masses() ? pair_kernel_of<true, false, kPeriodic>(pipeline.has_torque(), zoned)
+                                 : pair_kernel_of<false, false, kPeriodic>(pipeline.has_torque(), zoned);
 }
 }  // namespace
 
-PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed) {
-  if (mixed)
-    return pipeline.reads_masses() ? pair_kernel_of<true, true>(pipeline.has_torque(), zoned)
-                                   : pair_kernel_of<false, true>(pipeline.has_torque(), zoned);
-  return pipeline.reads_masses() ? pair_kernel_of<true, false>(pipeline.has_torque(), zoned)
-                                 : pair_kernel_of<false, false>(pipeline.has_torque(), zoned);
+PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed, bool periodic) {
+  return periodic ? pair_kernel_periodic<true>(pipeline, zoned, mixed) : pair_kernel_periodic<false>(pipeline, zoned, mixed);
 }
 
 void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std::size_t last) {

@@ -91,7 +91,7 @@ using PairRangeFn = void (*)(const PairSweep&, std::size_t first, std::size_t la
 /// without the masses its stages read), with or without zones, for one
 /// material or several (`mixed`: each batch is grouped by material pair and
 /// evaluated run by run; one material keeps the single-pair path).
-PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed);
+PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed, bool periodic);
 
 /// The inputs of the wall sweep of one force evaluation.
 struct WallSweep {

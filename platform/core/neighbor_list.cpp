@@ -3,9 +3,12 @@
 #include "core/neighbor_list.hpp"
 
 #include "core/archive.hpp"
+#include "core/error.hpp"
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace domel::platform {
 
@@ -15,6 +18,23 @@ inline std::uint64_t pair_key(std::uint64_t a, std::uint64_t b) {
   return (a << 32) ^ b ^ (a >> 32);
 }
 }  // namespace
+
+std::size_t PeriodicBox::wrap(ParticleStore& s) const {
+  std::size_t moved = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (!axis[a]) continue;
+    std::vector<double>& x = a == 0 ? s.x : a == 1 ? s.y : s.z;
+    const double L = length(a);
+    for (double& v : x) {
+      if (v >= lo[a] && v < hi[a]) continue;
+      v -= L * std::floor((v - lo[a]) / L);
+      if (v >= hi[a]) v -= L;  // round-off at the face
+      if (v < lo[a]) v = lo[a];
+      ++moved;
+    }
+  }
+  return moved;
+}
 
 bool NeighborList::needs_rebuild(const ParticleStore& s) const {
   if (layout_stale(s)) return true;
@@ -68,6 +88,55 @@ class LiveHistory {
   std::size_t mask_ = 0;
 };
 }  // namespace
+
+template <class CellOf, class Visit>
+void NeighborList::for_each_periodic_pair(std::size_t a_first, std::size_t a_last, const int dim[3],
+                                          const uint32_t* start, const uint32_t* order, const double per[3],
+                                          const double inv_per[3], CellOf&& cell_of, const ParticleStore& s,
+                                          double near_gap, Visit&& visit) const {
+  // the distinct neighbour offsets per axis
+  int offs[3][3], noff[3];
+  for (int a = 0; a < 3; ++a) {
+    noff[a] = 0;
+    const int from = box_.axis[a] && dim[a] < 3 ? 0 : -1;
+    const int to = box_.axis[a] && dim[a] == 1 ? 0 : 1;
+    for (int o = from; o <= to; ++o) offs[a][noff[a]++] = o;
+  }
+  for (std::size_t a = a_first; a < a_last; ++a) {
+    int c[3];
+    cell_of(a, c);
+    const double xa = s.x[a], ya = s.y[a], za = s.z[a], ra = s.radius[a];
+    const bool fixed_a = (s.flags[a] & ParticleStore::kFixed) != 0;
+    for (int kz = 0; kz < noff[2]; ++kz) {
+      int cz = c[2] + offs[2][kz];
+      if (box_.axis[2]) cz = (cz + dim[2]) % dim[2];
+      else if (cz < 0 || cz >= dim[2]) continue;
+      for (int ky = 0; ky < noff[1]; ++ky) {
+        int cy = c[1] + offs[1][ky];
+        if (box_.axis[1]) cy = (cy + dim[1]) % dim[1];
+        else if (cy < 0 || cy >= dim[1]) continue;
+        for (int kx = 0; kx < noff[0]; ++kx) {
+          int cx = c[0] + offs[0][kx];
+          if (box_.axis[0]) cx = (cx + dim[0]) % dim[0];
+          else if (cx < 0 || cx >= dim[0]) continue;
+          const std::size_t cc = (static_cast<std::size_t>(cz) * dim[1] + cy) * dim[0] + cx;
+          for (uint32_t q = start[cc]; q < start[cc + 1]; ++q) {
+            const uint32_t b = order[q];
+            if (b <= a) continue;
+            if (fixed_a && (s.flags[b] & ParticleStore::kFixed) != 0) continue;
+            const double rb = s.radius[b];
+            const double ddx = min_image(xa - s.x[b], per[0], inv_per[0]);
+            const double ddy = min_image(ya - s.y[b], per[1], inv_per[1]);
+            const double ddz = min_image(za - s.z[b], per[2], inv_per[2]);
+            const double cut = ra + rb + skin_;
+            const double d2 = ddx * ddx + ddy * ddy + ddz * ddz;
+            if (d2 < cut * cut) visit(a, b, std::sqrt(d2) - ra - rb < near_gap);
+          }
+        }
+      }
+    }
+  }
+}
 
 void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   const std::size_t n = s.size();
@@ -134,7 +203,18 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     }
     // Every cell must be at least one cutoff wide, so that all partners of a
     // particle lie in its own or an adjacent cell: floor(span / cutoff) cells.
+    // A periodic axis spans its box, the cells of both faces adjacent.
     const double cell = 2.0 * rmax + skin_;
+    for (int a = 0; a < 3; ++a)
+      if (box_.axis[a]) {
+        if (box_.length(a) < 2.0 * cell)
+          throw RuntimeError("periodic box " + std::to_string(box_.length(a)) + " m long along " +
+                                   std::string(1, static_cast<char>('x' + a)) +
+                                   ", less than twice the neighbour-list cut-off " + std::to_string(cell) +
+                                   " m (largest diameter + skin): a particle would meet two images of another");
+        lo[a] = box_.lo[a];
+        hi[a] = box_.hi[a];
+      }
     int dim[3];
     for (int a = 0; a < 3; ++a) {
       const double span = hi[a] - lo[a];
@@ -150,6 +230,7 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
       std::vector<double> c(n);
       const std::size_t k_lo = n / 1000, k_hi = n - 1 - n / 1000;
       for (int a = 0; a < 3; ++a) {
+        if (box_.axis[a]) continue;  // spans its box
         const std::vector<double>& src = a == 0 ? s.x : a == 1 ? s.y : s.z;
         std::copy(src.begin(), src.begin() + static_cast<std::ptrdiff_t>(n), c.begin());
         std::nth_element(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(k_lo), c.end());
@@ -192,7 +273,17 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
     // in order, so the list is exactly the one-thread list for any thread
     // count (entries in order of a, then of the cell scan).
     // visit(a, b, near) for each pair within the cut-off, b > a.
+    // Periodic axes: the neighbour cells wrap around, each visited once
+    // (with 2 cells the one below is the one above), and distances are
+    // taken to the nearest image.
+    double per[3], inv_per[3];
+    box_.periods(per, inv_per);
+    const bool periodic = box_.any();
     auto for_each_pair = [&](std::size_t a_first, std::size_t a_last, auto&& visit) {
+      if (periodic) {
+        for_each_periodic_pair(a_first, a_last, dim, start.data(), order.data(), per, inv_per, cell_of, s, h, visit);
+        return;
+      }
       const double skin = skin_;
       for (std::size_t a = a_first; a < a_last; ++a) {
         int c[3];

@@ -12,11 +12,38 @@
 #include "core/particle_store.hpp"
 #include "core/thread_pool.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace domel::platform {
+
+/// Periodic boundaries of a subdomain (subdomains[].periodic): along each
+/// periodic axis a the space repeats with period L_a = hi[a] - lo[a].
+/// Positions are wrapped into [lo, hi) when the lists are rebuilt (the
+/// step's exchange phase); between rebuilds a particle may stray past a
+/// face by up to half the skin. Pairs interact through their nearest image
+/// (the minimum-image convention), which is unique while L_a is at least
+/// twice the list cut-off (checked at every build).
+struct PeriodicBox {
+  bool axis[3] = {false, false, false};
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  bool any() const { return axis[0] || axis[1] || axis[2]; }
+  double length(int a) const { return hi[a] - lo[a]; }
+  /// The period along each axis, 0 where not periodic (for min_image()).
+  void periods(double L[3], double inv_L[3]) const {
+    for (int a = 0; a < 3; ++a) {
+      L[a] = axis[a] ? length(a) : 0.0;
+      inv_L[a] = axis[a] ? 1.0 / length(a) : 0.0;
+    }
+  }
+  /// Wrap the particles' positions into the box (returns how many moved).
+  std::size_t wrap(ParticleStore& s) const;
+};
+
+/// The nearest image of a separation d along an axis of period L (0: none).
+inline double min_image(double d, double L, double inv_L) { return d - L * std::nearbyint(d * inv_L); }
 
 class ArchiveWriter;
 class ArchiveReader;
@@ -28,6 +55,8 @@ class NeighborList {
     stride_ = history_stride;
   }
   double skin() const { return skin_; }
+  void set_periodic(const PeriodicBox& box) { box_ = box; }
+  const PeriodicBox& periodic() const { return box_; }
   uint32_t stride() const { return stride_; }
 
   /// Full check: the store's layout changed, or a particle moved more than
@@ -78,8 +107,13 @@ class NeighborList {
   std::vector<uint8_t> touching;   ///< 1 while the pair is in contact (history live)
 
  private:
+  template <class CellOf, class Visit>
+  void for_each_periodic_pair(std::size_t a_first, std::size_t a_last, const int dim[3], const uint32_t* start,
+                              const uint32_t* order, const double per[3], const double inv_per[3], CellOf&& cell_of,
+                              const ParticleStore& s, double near_gap, Visit&& visit) const;
   double skin_ = 0.0;
   uint32_t stride_ = 0;
+  PeriodicBox box_;
   std::size_t builds_ = 0;
   std::vector<double> x0_, y0_, z0_;
   std::vector<std::uint64_t> built_ids_;  ///< ids at the last build (history carry-over)

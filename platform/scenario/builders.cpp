@@ -197,7 +197,7 @@ void check_initial_particles(Build& b, const Subdomain& sub, const json& sd, con
     return;
   }
   const double limit = b.doc["run"]["max_initial_overlap"].get<double>();
-  const InitialOverlaps o = find_initial_overlaps(s, limit);
+  const InitialOverlaps o = find_initial_overlaps(s, limit, sub.periodic());
   if (o.pairs > 0)
     spdlog::info("subdomain '{}': {} overlapping pair(s) at the start, the worst {:.3g} % of the pair's mean diameter "
                  "(ids {} and {})", name, o.pairs, 100.0 * o.worst, o.worst_ids[0], o.worst_ids[1]);
@@ -514,6 +514,18 @@ void build_subdomain(Build& b, std::size_t k) {
   std::vector<PourProbe> pour_radii;
   build_pours(b, *sub, sd, base, pour_radii);
   if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
+  PeriodicBox box;
+  if (const json* per = member(sd, "periodic")) {
+    for (int a = 0; a < 3; ++a) {
+      const std::string ax(1, static_cast<char>('x' + a));
+      if (!per->contains(ax)) continue;
+      box.axis[a] = true;
+      box.lo[a] = (*per)[ax][0].get<double>();
+      box.hi[a] = (*per)[ax][1].get<double>();
+    }
+    sub->set_periodic(box);
+    box.wrap(sub->store());  // inserted at the faces' edge: inside, as the first list build would have it
+  }
   check_initial_particles(b, *sub, sd, base);
   // The fine level of a coupling starts empty: its particles will be its
   // parent's parcels at its own ratio, which set its skin and time step.
@@ -541,6 +553,14 @@ void build_subdomain(Build& b, std::size_t k) {
   for (double r : sub->store().radius) rmax = std::max(rmax, r);
   for (const PourProbe& p : pour_radii) rmax = std::max(rmax, p.r_max);
   sub->set_skin(sd["skin"].get<double>() * 2.0 * (rmax > 0 ? rmax : 1e-3));
+  for (int a = 0; a < 3; ++a) {
+    const double cut = 2.0 * rmax + sub->skin();
+    if (box.axis[a] && box.length(a) < 2.0 * cut)
+      b.ck.add(base + "/periodic/" + std::string(1, static_cast<char>('x' + a)),
+               "expected a period of at least twice the neighbour-list cut-off (largest diameter + skin = " +
+                   fmt_num(cut) + " m), found " + fmt_num(box.length(a)) + " m",
+               "lengthen the periodic box to " + fmt_num(2.0 * cut) + " m or more");
+  }
   {
     double rmin = rmax;
     for (double r : sub->store().radius) rmin = std::min(rmin, r);

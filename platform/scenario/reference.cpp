@@ -192,6 +192,7 @@ std::string scenario_reference_markdown(const PluginRegistry& registry) {
                              {"gravity_rotation", "Gravity over time: a rotation (`gravity`)"},
                              {"region", "Region (`insert[].region`)"},
                              {"subdomain", "Subdomain (`subdomains[]`)"},
+                             {"periodic", "Periodic boundaries (`subdomains[].periodic`)"},
                              {"contact", "Contact model (`subdomains[].contact`)"},
                              {"insertion_model", "Inserter, platform keys (`subdomains[].insert[]`)"},
                              {"pour", "Pour (`subdomains[].pour[]`)"},

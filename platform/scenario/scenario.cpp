@@ -36,6 +36,60 @@ json platform_block_properties(uint32_t kind) {
   return json::object();
 }
 
+
+/// What must not cross periodic axis a ([lo, hi]) of subdomain `sd_name`
+/// (reported at `pointer`, the periodic range): walls not invariant along
+/// the axis, couplings and a fluid block, mass-flow planes across it.
+void check_periodic_axis(const json& doc, int a, double lo, double hi, const std::string& sd_name,
+                         const std::string& pointer, Checker& ck) {
+  const std::string ax(1, static_cast<char>('x' + a));
+  auto refuse = [&](const std::string& where, const std::string& what, const std::string& hint) {
+    ck.add(where, what + ", across the periodic axis " + ax + " of subdomain '" + sd_name + "' (" + pointer + ")", hint);
+  };
+  if (const json* walls = member(doc, "walls"); walls && walls->is_array())
+    for (std::size_t w = 0; w < walls->size(); ++w) {
+      const json& wall = (*walls)[w];
+      const std::string wb = idx("/walls", w);
+      const std::string t = (member(wall, "type") && wall["type"].is_string()) ? wall["type"].get<std::string>() : "";
+      if (t == "plane") {
+        if (is_vec3(member(wall, "normal")) && std::fabs(wall["normal"][a].get<double>()) > 0)
+          refuse(wb + "/normal", "a plane whose normal has an " + ax + " component",
+                 "make the plane parallel to " + ax + ", or drop the periodic axis");
+      } else if (t == "box") {
+        std::set<std::string> open;
+        if (const json* o = member(wall, "open"); o && o->is_array())
+          for (const auto& f : *o)
+            if (f.is_string()) open.insert(f.get<std::string>());
+        if (!open.count(ax + "min") || !open.count(ax + "max"))
+          refuse(wb + "/open", "a box with a face across " + ax, "add \"" + ax + "min\" and \"" + ax + "max\" to \"open\"");
+      } else if (t == "cylinder") {
+        const bool along = axis_index(member(wall, "axis")) == a;
+        const double b0 = member(wall, "bottom") && wall["bottom"].is_number() ? wall["bottom"].get<double>() : 0.0;
+        const double b1 = member(wall, "top") && wall["top"].is_number() ? wall["top"].get<double>() : 0.0;
+        const bool closed = (!member(wall, "closed_bottom") || wall["closed_bottom"] == true) ||
+                            (member(wall, "closed_top") && wall["closed_top"] == true);
+        if (!along || closed || b0 > lo || b1 < hi)
+          refuse(wb, std::string("a cylinder ") + (!along ? "whose axis is not " + ax : closed ? "with a bottom or lid" : "shorter than the periodic box"),
+                 "a periodic pipe is a cylinder along " + ax + " with \"closed_bottom\": false spanning [lo, hi]");
+      } else if (!t.empty()) {
+        refuse(wb + "/type", "a " + t + " wall", "only planes, open boxes and open cylinders are invariant along a periodic axis");
+      }
+    }
+  if (const json* c = member(doc, "couplings"); c && c->is_array() && !c->empty())
+    refuse("/couplings", "couplings between levels", "couplings do not support periodic boundaries yet");
+  if (member(doc, "fluid")) refuse("/fluid", "a fluid block", "the fluid grid is not periodic yet");
+  if (const json* out = member(doc, "output"))
+    if (const json* planes = member(*out, "mass_flow"); planes && planes->is_array())
+      for (std::size_t i = 0; i < planes->size(); ++i) {
+        const json& pl = (*planes)[i];
+        const bool other = (member(pl, "subdomain") && pl["subdomain"].is_string()) && pl["subdomain"].get<std::string>() != sd_name;
+        if (!other && is_vec3(member(pl, "normal")) && std::fabs(pl["normal"][a].get<double>()) > 0)
+          refuse(idx("/output/mass_flow", i) + "/normal", "a mass-flow plane whose normal has an " + ax + " component",
+                 "particles re-entering through the periodic face would cross it backwards; measure the flux with "
+                 "region_mass or the cell grids");
+      }
+}
+
 }  // namespace
 
 const json& platform_scenario_schema() {
@@ -410,6 +464,25 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
       ck.add("/gravity", "a fluid block needs a constant gravity, found one that changes with time",
              "give gravity as a vector");
   }
+
+  // periodic boundaries: a valid box, and nothing across a periodic axis
+  if (const json* sds = member(doc, "subdomains"); sds && sds->is_array())
+    for (std::size_t k = 0; k < sds->size(); ++k) {
+      const json* per = member((*sds)[k], "periodic");
+      if (!per || !per->is_object()) continue;
+      const std::string base = idx("/subdomains", k) + "/periodic";
+      const std::string sd_name = (member((*sds)[k], "name") && (*sds)[k]["name"].is_string()) ? (*sds)[k]["name"].get<std::string>() : "";
+      for (int a = 0; a < 3; ++a) {
+        const std::string ax(1, static_cast<char>('x' + a));
+        const json* range = member(*per, ax.c_str());
+        if (!range || !range->is_array() || range->size() != 2 || !(*range)[0].is_number() || !(*range)[1].is_number())
+          continue;
+        const double lo = (*range)[0].get<double>(), hi = (*range)[1].get<double>();
+        if (hi <= lo)
+          ck.add(base + "/" + ax, "expected lo < hi, found [" + fmt_num(lo) + ", " + fmt_num(hi) + "]");
+        check_periodic_axis(doc, a, lo, hi, sd_name, base + "/" + ax, ck);
+      }
+    }
 
   // subdomains
   std::set<std::string> sd_names;

@@ -74,7 +74,7 @@ void count_contacts(ParticleStore& s, const NeighborList& list, std::size_t scre
   }
 }
 
-InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit) {
+InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit, const PeriodicBox& box) {
   InitialOverlaps out;
   const std::size_t n = s.size();
   if (n < 2) return out;
@@ -103,8 +103,20 @@ InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit) {
   for (std::size_t k = 0; k < n; ++k)
     cells[key(coord(s.x[k], 0), coord(s.y[k], 1), coord(s.z[k], 2))].push_back(static_cast<std::uint32_t>(k));
   std::vector<InitialOverlaps::Pair> above;
-  for (std::size_t p = 0; p < n; ++p) {
-    const long long ci = coord(s.x[p], 0), cj = coord(s.y[p], 1), ck = coord(s.z[p], 2);
+  // periodic axes: the images of each particle one period away on either side
+  std::vector<std::array<double, 3>> shifts;
+  for (int sx = -1; sx <= 1; ++sx)
+    for (int sy = -1; sy <= 1; ++sy)
+      for (int sz = -1; sz <= 1; ++sz) {
+        const int sh[3] = {sx, sy, sz};
+        bool ok = true;
+        for (int a = 0; a < 3; ++a) ok = ok && (sh[a] == 0 || box.axis[a]);
+        if (ok) shifts.push_back({sx * box.length(0), sy * box.length(1), sz * box.length(2)});
+      }
+  for (std::size_t p = 0; p < n; ++p)
+    for (const auto& shift : shifts) {
+    const double xp = s.x[p] + shift[0], yp = s.y[p] + shift[1], zp = s.z[p] + shift[2];
+    const long long ci = coord(xp, 0), cj = coord(yp, 1), ck = coord(zp, 2);
     for (long long di = -1; di <= 1; ++di)
       for (long long dj = -1; dj <= 1; ++dj)
         for (long long dk = -1; dk <= 1; ++dk) {
@@ -112,7 +124,7 @@ InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit) {
           if (it == cells.end()) continue;
           for (std::uint32_t q : it->second) {
             if (q <= p) continue;  // each pair once: q sits in one cell, visited once from p
-            const double dx = s.x[p] - s.x[q], dy = s.y[p] - s.y[q], dz = s.z[p] - s.z[q];
+            const double dx = xp - s.x[q], dy = yp - s.y[q], dz = zp - s.z[q];
             const double rsum = s.radius[p] + s.radius[q];
             const double d2 = dx * dx + dy * dy + dz * dz;
             if (d2 >= rsum * rsum) continue;

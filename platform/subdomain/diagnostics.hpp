@@ -57,7 +57,8 @@ struct InitialOverlaps {
   std::vector<Pair> above;
   std::size_t above_count = 0;  ///< how many pairs exceed `limit` in all
 };
-InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit);
+/// Periodic axes of `box`: pairs through an image count too.
+InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit, const PeriodicBox& box = {});
 
 /// The kinetic part of the statistics (particles, fixed, energies, angular speeds).
 SubdomainStats kinetic_stats(const ParticleStore& s);

@@ -110,6 +110,7 @@ void Subdomain::setup() {
   const uint32_t stride = pipeline_->history_stride();
   nlist_.configure(skin_, stride);
   update_walls(time_);
+  exchange();
   rebuild_lists();
   if (gravity_) gravity_->at(time_, body_forces_.gravity);
   const std::size_t n = store_.size();
@@ -143,6 +144,12 @@ void Subdomain::setup() {
   }
 }
 
+
+void Subdomain::exchange() {
+  // Periodic boundaries: the migration of one process, particles that left
+  // through a periodic face re-enter at the other
+  if (nlist_.periodic().any()) nlist_.periodic().wrap(store_);
+}
 
 void Subdomain::rebuild_lists() {
   // Spatial re-ordering (docs/performance.md): particles that
@@ -320,7 +327,10 @@ void Subdomain::step_fused() {
       for (const DriftCounts& c : drift_counts_)
         if (c.nonfinite != 0.0) throw_nonfinite("in the second half kick", time_, steps_);
     update_walls(time_ + dt);
-    if (rebuild_due(stale)) rebuild_lists();
+    if (rebuild_due(stale)) {
+      exchange();
+      rebuild_lists();
+    }
     // The forces; with threads, the other threads' sums and the wall
     // contacts are left to the next pass 1 (or synchronize()), as is the
     // second half kick: one fork/join and one sweep less per step.
@@ -364,6 +374,7 @@ void Subdomain::step_in_order() {
   run_hooks(Phase::initial_integrate);
   update_walls(time_ + dt);
   if (rebuild_due(stale)) {
+    exchange();
     run_hooks(Phase::exchange);
     rebuild_lists();
     run_hooks(Phase::neighbor);
@@ -435,7 +446,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
     ts.pair_max_ratio = 0.0;
   }
   if (nt == 1) {
-    const PairRangeFn range = pair_kernel(*pipeline_, false, materials_.size() > 1);
+    const PairRangeFn range = pair_kernel(*pipeline_, false, materials_.size() > 1, nlist_.periodic().any());
     range(sweep, 0, nlist_.near_size(), scratch_[0], 0, s.size(), direct, direct);
     if (far) range(sweep, nlist_.near_size(), nlist_.size(), scratch_[0], 0, s.size(), direct, direct);
   } else {
@@ -452,7 +463,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
       const ForceAccumulator shared = t > 0 ? partition_.private_accumulator(t, n) : direct;
       const ForcePartition::ThreadForces& tf = partition_.thread(t);
       // thread 0 adds all its forces into the store
-      const PairRangeFn range = pair_kernel(*pipeline_, t > 0, materials_.size() > 1);
+      const PairRangeFn range = pair_kernel(*pipeline_, t > 0, materials_.size() > 1, nlist_.periodic().any());
       const auto [near_first, near_last] = partition_.entries(0, t);
       range(sweep, near_first, near_last, ts, tf.own_lo, tf.own_hi, direct, shared);
       if (far) {

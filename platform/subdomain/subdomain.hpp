@@ -80,6 +80,9 @@ class Subdomain {
   /// when their initial forces are not finite (setup()).
   void set_initial_source(std::string source) { initial_source_ = std::move(source); }
   void set_skin(double skin) { skin_ = skin; }
+  /// Periodic boundaries (core/neighbor_list.hpp); call before setup().
+  void set_periodic(const PeriodicBox& box) { nlist_.set_periodic(box); }
+  const PeriodicBox& periodic() const { return nlist_.periodic(); }
   /// Re-order the store by spatial cells every `builds` neighbour-list
   /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
   void set_reorder_every(std::size_t builds) { reorder_every_ = builds; }
@@ -179,6 +182,8 @@ class Subdomain {
   /// Rethrow a kernel's failure with the subdomain, step and time.
   [[noreturn]] void rethrow_with_context(const std::exception& e, const char* during) const;
 
+  /// The exchange phase's own work: wrap positions into a periodic box.
+  void exchange();
   void rebuild_lists();
   /// Move the moving walls to time t; rebuild the list of a wall that became
   /// active or moved more than skin/2 since its build, clear a removed one's.

@@ -304,3 +304,71 @@ TEST(Suggest, DidYouMeanOrFullList) {
   EXPECT_EQ(suggest("spring", {"linear", "hertz"}), "valid: hertz, linear");
   EXPECT_EQ(suggest("x", {}), "");
 }
+
+// Periodic boundaries: the list holds exactly the pairs within the cut-off
+// of their nearest image (brute force over the 27 images, on a periodic
+// cloud in x and z, 2 cells and more per axis), on 1 and 2 threads alike;
+// wrapping a particle by one period keeps its pairs and their history.
+TEST(NeighborList, PeriodicAxesFindPairsThroughTheFacesAndKeepTheirHistory) {
+  for (double L : {0.05, 0.009}) {  // 0.009: two cells along each periodic axis
+    ParticleStore s;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> pos(0.0, L), rad(0.001, 0.0015);
+    const std::size_t n = L > 0.02 ? 5000 : 60;
+    for (std::size_t k = 0; k < n; ++k) s.add(100 + k, pos(rng), pos(rng) * 4, pos(rng), rad(rng), 2500);
+    PeriodicBox box;
+    box.axis[0] = box.axis[2] = true;
+    box.hi[0] = box.hi[2] = L;
+    const double skin = 0.0005;
+    std::set<std::pair<std::uint64_t, std::uint64_t>> expected;
+    for (std::size_t a = 0; a < s.size(); ++a)
+      for (std::size_t b = a + 1; b < s.size(); ++b) {
+        double dx = s.x[a] - s.x[b], dz = s.z[a] - s.z[b];
+        dx -= L * std::nearbyint(dx / L);
+        dz -= L * std::nearbyint(dz / L);
+        const double dy = s.y[a] - s.y[b];
+        const double cut = s.radius[a] + s.radius[b] + skin;
+        if (dx * dx + dy * dy + dz * dz < cut * cut) expected.insert(std::minmax(s.id[a], s.id[b]));
+      }
+    ThreadPool pool(2);
+    for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
+      NeighborList nl;
+      nl.configure(skin, 3);
+      nl.set_periodic(box);
+      nl.build(s, p);
+      std::set<std::pair<std::uint64_t, std::uint64_t>> got;
+      for (std::size_t k = 0; k < nl.size(); ++k) got.insert({s.id[nl.i[k]], s.id[nl.j[k]]});
+      EXPECT_EQ(got.size(), nl.size()) << "a pair listed twice, L = " << L;
+      EXPECT_EQ(got, expected) << "L = " << L;
+      // history survives a particle leaving through a face and re-entering
+      const auto tags = mark_live(nl, s, 3);
+      ParticleStore moved = s;
+      for (std::size_t k = 0; k < moved.size(); k += 2) moved.x[k] += L;  // one period out
+      EXPECT_GT(box.wrap(moved), 0u);
+      for (std::size_t k = 0; k < moved.size(); ++k) {
+        EXPECT_GE(moved.x[k], 0.0);
+        EXPECT_LT(moved.x[k], L);
+      }
+      nl.build(moved, p);
+      std::size_t kept = 0;
+      for (std::size_t k = 0; k < nl.size(); ++k) {
+        const auto it = tags.find({moved.id[nl.i[k]], moved.id[nl.j[k]]});
+        if (it == tags.end()) continue;
+        ASSERT_TRUE(nl.touching[k]);
+        EXPECT_EQ(nl.history[k * 3], it->second);
+        ++kept;
+      }
+      EXPECT_EQ(kept, tags.size());
+    }
+  }
+  // a box shorter than twice the cut-off is refused
+  ParticleStore s;
+  s.add(1, 0.001, 0, 0, 0.001, 2500);
+  PeriodicBox box;
+  box.axis[0] = true;
+  box.hi[0] = 0.005;
+  NeighborList nl;
+  nl.configure(0.001, 3);
+  nl.set_periodic(box);
+  EXPECT_THROW(nl.build(s), RuntimeError);
+}
