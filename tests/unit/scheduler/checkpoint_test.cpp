@@ -204,6 +204,17 @@ TEST(Checkpoint, ShakenBoxUnderAServoLidWithTiltingGravityRestartedIsBitIdentica
   for (int threads : {1, 2}) expect_restart_identical(shaken(), "shaken", 2345, 0.007, threads);
 }
 
+TEST(Checkpoint, PeriodicChuteRestartedIsBitIdentical) {
+  // the chute's first 50 ms (the fill falling, positions wrapped through
+  // both periodic faces), stopped between two list builds
+  json d = read_json("scenarios/validation/chute.json");
+  d["run"]["duration"] = 0.05;
+  d["output"]["vtk_interval"] = 0.01;
+  d["output"]["probe_interval"] = 0.005;
+  d["output"]["grids"][0]["write_interval"] = 0.01;
+  for (int threads : {1, 2}) expect_restart_identical(d, "chute", 2345, 0.007, threads);
+}
+
 TEST(Checkpoint, SettleRestartedIsBitIdentical) {
   for (int threads : {1, 2}) expect_restart_identical(settle(), "settle", 2345, 0.007, threads);
 }
