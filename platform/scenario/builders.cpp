@@ -634,6 +634,15 @@ void build_particle_flow(Build& b) {
         rm.subdomain = subdomain_index(b, d["subdomain"], idx("/output/region_mass", i) + "/subdomain");
       rm.region = make_region(d["region"]);
       if (d.contains("max_speed")) rm.max_speed = d["max_speed"].get<double>();
+      if (d.contains("material")) {
+        const std::string m = d["material"].get<std::string>();
+        if (auto it = b.mat_index.find(m); it != b.mat_index.end()) rm.material = it->second;
+        else {
+          std::vector<std::string> names;
+          for (const auto& [n, k] : b.mat_index) names.push_back(n);
+          b.ck.add(idx("/output/region_mass", i) + "/material", "unknown material '" + m + "'", suggest(m, names));
+        }
+      }
       for (const auto& other : b.sim.region_mass)
         if (other.name == rm.name)
           b.ck.add(idx("/output/region_mass", i) + "/name", "duplicate region_mass name '" + rm.name + "'");

@@ -77,7 +77,16 @@ std::pair<double, std::size_t> mass_in_region(const std::vector<std::unique_ptr<
   for (std::size_t d = 0; d < subdomains.size(); ++d) {
     if (rm.subdomain != kAllSubdomains && rm.subdomain != d) continue;
     const ParticleStore& s = subdomains[d]->store();
+    // the material's local index in this subdomain (none: it has no such particles)
+    int local = -1;
+    if (rm.material) {
+      const auto& mats = subdomains[d]->materials();
+      const auto it = std::find(mats.begin(), mats.end(), *rm.material);
+      if (it == mats.end()) continue;
+      local = static_cast<int>(it - mats.begin());
+    }
     for (std::size_t k = 0; k < s.size(); ++k) {
+      if (local >= 0 && s.material[k] != local) continue;
       if (!region_contains(rm.region, s.x[k], s.y[k], s.z[k])) continue;
       if (rm.max_speed && s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k] >= v2max) continue;
       kg += s.mass[k];

@@ -55,6 +55,7 @@ struct RegionMassProbe {
   std::size_t subdomain = kAllSubdomains;  ///< the only subdomain counted, or all
   domel_region_v1 region{};
   std::optional<double> max_speed;  ///< [m/s] only particles slower than this
+  std::optional<std::size_t> material;  ///< only particles of this scenario material
 };
 
 /// The unit of a probes.csv column ("s", "J", "rad/s", "kg", "1" for counts

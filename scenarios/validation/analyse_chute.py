@@ -67,6 +67,7 @@ def main():
     ap.add_argument("folders", nargs="+")
     ap.add_argument("--window", type=float, default=1.0, help="seconds at the end of the run to average (default 1)")
     ap.add_argument("--plot", help="write the profiles to this PNG")
+    ap.add_argument("--title", default="", help="the plot's title")
     a = ap.parse_args()
     runs = []
     for folder in a.folders:
@@ -77,9 +78,9 @@ def main():
         print(f"{folder}: H = {H / D:.2f} d, surface velocity {max(v):.3f} m/s, best beta {best:.2f} "
               f"(rms {fit(z, v, H, best)[2]:.4f} m/s), beta 1.5 rms {fit(z, v, H, 1.5)[2]:.4f}, "
               f"linear rms {fit(z, v, H, 1.0)[2]:.4f}")
-        runs.append((folder, z, v, H))
+        runs.append((folder, z, v, H, phi))
     if len(runs) == 2:
-        (_, za, va, Ha), (_, zb, vb, Hb) = runs
+        (_, za, va, Ha, _), (_, zb, vb, Hb, _) = runs
         bulk = [k for k in range(min(len(za), len(zb))) if 2.5 * D < za[k] < min(Ha, Hb) - 1.5 * D]
         worst = max(abs(va[k] - vb[k]) for k in bulk) / max(va)
         print(f"largest bulk-layer difference: {100 * worst:.1f} % of the surface velocity over {len(bulk)} layers")
@@ -88,15 +89,19 @@ def main():
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(figsize=(5, 4.5))
-        for (folder, z, v, H), mark in zip(runs, "os^d"):
-            ax.plot(v, [zk / D for zk in z], mark, mfc="none", label=os.path.basename(os.path.normpath(folder)))
-        _, z, v, H = runs[0]
+        for (folder, z, v, H, phi), mark in zip(runs, "os^d"):
+            filled = [k for k in range(len(z)) if phi[k] > 0.02]  # layers above the surface hold nothing
+            ax.plot([v[k] for k in filled], [z[k] / D for k in filled], mark, mfc="none",
+                    label=os.path.basename(os.path.normpath(folder)))
+        _, z, v, H, _ = runs[0]
         c0, c1, _ = fit(z, v, H, 1.5)
         zs = [2.5 * D + k * (H - 4.0 * D) / 50 for k in range(51)]
         ax.plot([c0 + c1 * (H - zk) ** 1.5 for zk in zs], [zk / D for zk in zs], "k-", lw=1,
                 label="Bagnold: v_s - c (H - z)^1.5")
         ax.set_xlabel("v_x [m/s]")
         ax.set_ylabel("z / d")
+        if a.title:
+            ax.set_title(a.title, fontsize=9)
         ax.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(a.plot, dpi=120)
