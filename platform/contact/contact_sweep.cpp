@@ -373,13 +373,15 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
         const double ci = ts.ci[q];
         s.tx[i] += -ci * l.cx + buf.tqx[q]; s.ty[i] += -ci * l.cy + buf.tqy[q]; s.tz[i] += -ci * l.cz + buf.tqz[q];
         copy_row(buf.history.data() + q * stride, list.history.data() + e * stride, stride);
-        if (load) {
-          load[0] += l.fx; load[1] += l.fy; load[2] += l.fz;
-        }
         if (sw.record)  // the contact point lies on the wall, ci from the centre along -n
           ts.records.push_back({i, ContactRecord::kWall, l.fx, l.fy, l.fz, s.x[i] - ci * nx, s.y[i] - ci * ny,
                                 s.z[i] - ci * nz, static_cast<uint32_t>(w)});
       }
+      if (load)  // a servo wall's load: a pass of its own, so that other walls pay nothing
+        for (uint32_t q = 0; q < c; ++q) {
+          const Load l = load_of(buf.fn[q], buf.nx[q], buf.ny[q], buf.nz[q], buf.ftx[q], buf.fty[q], buf.ftz[q]);
+          load[0] += l.fx; load[1] += l.fy; load[2] += l.fz;
+        }
       contacts += c;
       c = 0;
     };

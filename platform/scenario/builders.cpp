@@ -634,6 +634,7 @@ void build_particle_flow(Build& b) {
         rm.subdomain = subdomain_index(b, d["subdomain"], idx("/output/region_mass", i) + "/subdomain");
       rm.region = make_region(d["region"]);
       if (d.contains("max_speed")) rm.max_speed = d["max_speed"].get<double>();
+      rm.centre_of_mass = d["centre_of_mass"].get<bool>();
       if (d.contains("material")) {
         const std::string m = d["material"].get<std::string>();
         if (auto it = b.mat_index.find(m); it != b.mat_index.end()) rm.material = it->second;

@@ -68,11 +68,13 @@ std::string iso_time_now() {
   return buf;
 }
 
-/// output.region_mass: kilograms and count of the particles inside the region.
+/// output.region_mass: kilograms and count of the particles inside the
+/// region, and (when com is given) their centre of mass.
 std::pair<double, std::size_t> mass_in_region(const std::vector<std::unique_ptr<Subdomain>>& subdomains,
-                                              const RegionMassProbe& rm) {
+                                              const RegionMassProbe& rm, double* com = nullptr) {
   double kg = 0;
   std::size_t n = 0;
+  double mx = 0, my = 0, mz = 0;
   const double v2max = rm.max_speed ? *rm.max_speed * *rm.max_speed : 0.0;
   for (std::size_t d = 0; d < subdomains.size(); ++d) {
     if (rm.subdomain != kAllSubdomains && rm.subdomain != d) continue;
@@ -90,8 +92,16 @@ std::pair<double, std::size_t> mass_in_region(const std::vector<std::unique_ptr<
       if (!region_contains(rm.region, s.x[k], s.y[k], s.z[k])) continue;
       if (rm.max_speed && s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k] >= v2max) continue;
       kg += s.mass[k];
+      mx += s.mass[k] * s.x[k];
+      my += s.mass[k] * s.y[k];
+      mz += s.mass[k] * s.z[k];
       ++n;
     }
+  }
+  if (com) {
+    com[0] = n ? mx / kg : std::nan("");
+    com[1] = n ? my / kg : std::nan("");
+    com[2] = n ? mz / kg : std::nan("");
   }
   return {kg, n};
 }
@@ -110,6 +120,7 @@ std::string probe_column_unit(const std::string& column) {
   if (name == "rate_kg_s") return "kg/s";
   if (name == "force_x" || name == "force_y" || name == "force_z") return "N";  // output.wall_loads
   if (name == "torque") return "N m";
+  if (name == "com_x" || name == "com_y" || name == "com_z") return "m";  // output.region_mass
   if (name == "servo_force") return "N";  // walls[].motion[].servo
   if (name == "servo_travel") return "m";
   return "";
@@ -190,6 +201,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (const auto& rm : region_mass) {
     columns.push_back(rm.name + ".mass_kg");
     columns.push_back(rm.name + ".particles");
+    if (rm.centre_of_mass)
+      for (const char* c : {".com_x", ".com_y", ".com_z"}) columns.push_back(rm.name + c);
   }
   for (const auto& c : flow.columns()) columns.push_back(c);
   for (const auto& c : contact_sample.columns()) columns.push_back(c);
@@ -324,9 +337,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       for (const auto& sd : subdomains)
         row.push_back(repose_angle(sd->store(), *repose_probe).value_or(std::nan("")));
     for (const auto& rm : region_mass) {
-      const auto [kg, n] = mass_in_region(subdomains, rm);
+      double com[3];
+      const auto [kg, n] = mass_in_region(subdomains, rm, com);
       row.push_back(kg);
       row.push_back(static_cast<double>(n));
+      if (rm.centre_of_mass) row.insert(row.end(), com, com + 3);
     }
     flow.check_planes(subdomains);
     flow.append_row(t, row);

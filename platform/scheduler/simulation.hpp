@@ -56,6 +56,7 @@ struct RegionMassProbe {
   domel_region_v1 region{};
   std::optional<double> max_speed;  ///< [m/s] only particles slower than this
   std::optional<std::size_t> material;  ///< only particles of this scenario material
+  bool centre_of_mass = false;          ///< also <name>.com_x, .com_y, .com_z
 };
 
 /// The unit of a probes.csv column ("s", "J", "rad/s", "kg", "1" for counts
