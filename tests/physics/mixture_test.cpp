@@ -16,6 +16,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
 #include <unistd.h>
 
 namespace dt = domel::test;
@@ -172,4 +175,42 @@ TEST(Mixture, EachPairsRollingFrictionHoldsOrReleasesItsSphereOnTheSameIncline) 
   const double expected = 5.0 / 7.0 * g * (std::sin(beta) - mu_b * std::cos(beta));
   EXPECT_NEAR(a_b, expected, 0.02 * expected);
   EXPECT_LT(std::fabs(s.vx[0]), 1e-3 * s.vx[1]);  // held: its speed a thousandth of b's
+}
+
+TEST(Mixture, RegionMassCountsOneMaterialAndGivesItsCentreOfMass) {
+  // three resting spheres: a at x = 0 and x = 0.01, b (denser) at x = 0.02;
+  // region_mass of material a: two spheres, centre x = 0.005 (equal masses);
+  // of b: one, at 0.02; of all: the mass-weighted centre. Exact but for
+  // round-off (1e-15 m); NaN where the region holds none.
+  json doc = mixture_doc(1e-6);
+  doc["subdomains"][0]["insert"] = {one_sphere("a", {0, 0, 0}, {0, 0, 0}), one_sphere("a", {0.01, 0, 0}, {0, 0, 0}),
+                                    one_sphere("b", {0.02, 0, 0}, {0, 0, 0})};
+  doc["run"] = {{"steps", 1}};
+  json everywhere = {{"box", {{"min", {-1, -1, -1}}, {"max", {1, 1, 1}}}}};
+  json nowhere = {{"box", {{"min", {0.5, 0.5, 0.5}}, {"max", {1, 1, 1}}}}};
+  doc["output"]["probe_interval"] = 1e-6;
+  doc["output"]["region_mass"] = {{{"name", "a"}, {"material", "a"}, {"centre_of_mass", true}, {"region", everywhere}},
+                                  {{"name", "b"}, {"material", "b"}, {"centre_of_mass", true}, {"region", everywhere}},
+                                  {{"name", "all"}, {"centre_of_mass", true}, {"region", everywhere}},
+                                  {{"name", "none"}, {"material", "a"}, {"centre_of_mass", true}, {"region", nowhere}}};
+  auto sim = dt::build(doc);
+  domel::platform::RunOptions opt;
+  opt.progress = false;
+  opt.output_directory = ::testing::TempDir() + "/mixture_region_mass";
+  sim->run(opt, dt::builtin_registry());
+  std::ifstream csv(opt.output_directory / "probes.csv");
+  std::string header, first;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  std::map<std::string, double> row;
+  std::stringstream hs(header), rs(first);
+  for (std::string n, v; std::getline(hs, n, ',') && std::getline(rs, v, ',');) row[n] = std::stod(v);
+  const double ma = 2500 * M_PI / 6 * kD * kD * kD, mb = 7800 * M_PI / 6 * kD * kD * kD;
+  EXPECT_EQ(row.at("a.particles"), 2);
+  EXPECT_NEAR(row.at("a.mass_kg"), 2 * ma, 1e-12 * ma);
+  EXPECT_NEAR(row.at("a.com_x"), 0.005, 1e-15);
+  EXPECT_EQ(row.at("b.particles"), 1);
+  EXPECT_NEAR(row.at("b.com_x"), 0.02, 1e-15);
+  EXPECT_NEAR(row.at("all.com_x"), (0.01 * ma + 0.02 * mb) / (2 * ma + mb), 1e-15);
+  EXPECT_TRUE(std::isnan(row.at("none.com_z")));
 }
