@@ -152,7 +152,12 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
   // Pass 1: counts, masses, solid volume, momentum of the mobile particles.
   cell_scratch_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const std::ptrdiff_t c = cell_of(s.x[k], s.y[k], s.z[k]);
+    double q[3] = {s.x[k], s.y[k], s.z[k]};
+    if (periodic_.any())  // a particle up to half a skin past a periodic face: binned at its image in the box
+      for (int a = 0; a < 3; ++a)
+        if (periodic_.axis[a] && (q[a] < periodic_.lo[a] || q[a] >= periodic_.hi[a]))
+          q[a] -= periodic_.length(a) * std::floor((q[a] - periodic_.lo[a]) / periodic_.length(a));
+    const std::ptrdiff_t c = cell_of(q[0], q[1], q[2]);
     cell_scratch_[k] = c;
     if (c < 0) continue;
     const double r = s.radius[k];
@@ -217,7 +222,7 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
       }
       const std::ptrdiff_t cj = cell_scratch_[r.j];
       if (ci < 0 && cj < 0) continue;
-      const double l[3] = {s.x[r.i] - s.x[r.j], s.y[r.i] - s.y[r.j], s.z[r.i] - s.z[r.j]};
+      const double l[3] = {s.x[r.i] - r.px, s.y[r.i] - r.py, s.z[r.i] - r.pz};  // j's nearest image
       if (ci >= 0) add_outer(&f.stress[9 * ci], l, r.fx, r.fy, r.fz, 0.5);
       if (cj >= 0) add_outer(&f.stress[9 * cj], l, r.fx, r.fy, r.fz, 0.5);
     }

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
 #include "geometry/wall.hpp"
 
@@ -37,7 +38,7 @@ struct ContactRecord {
   std::uint32_t i;        ///< particle index
   std::uint32_t j;        ///< partner particle index, or kWall
   double fx, fy, fz;      ///< force on i [N] (j receives the opposite)
-  double px, py, pz;      ///< wall contacts: the contact point [m]; unused for pairs
+  double px, py, pz;      ///< wall contacts: the contact point; pairs: j's position, or through a periodic face its image nearest to i [m]
   std::uint32_t wall = 0; ///< wall contacts: the subdomain's wall primitive; unused for pairs
   static constexpr std::uint32_t kWall = 0xffffffffu;
 };
@@ -137,6 +138,9 @@ class CellGrid {
   }
   /// Cell holding the point, binned half-open [lo, hi) per axis; -1 outside the box.
   std::ptrdiff_t cell_of(double x, double y, double z) const;
+  /// The sampled subdomain's periodic boundaries: positions are binned at
+  /// their image inside the periodic box.
+  void set_periodic(const PeriodicBox& box) { periodic_ = box; }
   /// True on the steps the grid samples (step % every == 0).
   bool due(std::uint64_t step) const { return step % static_cast<std::uint64_t>(spec_.every) == 0; }
 
@@ -155,7 +159,7 @@ class CellGrid {
   /// Instantaneous fields from the particle centres (binning by centre;
   /// particles outside the box are ignored), the kinetic stress about the
   /// cell's Favre velocity and the contact virial: a pair record adds
-  /// 1/2 (x_i - x_j) (x) F_i to i's cell and 1/2 to j's cell (a half whose
+  /// 1/2 (x_i - p) (x) F_i to i's cell (p: j, or its image nearest to i) and 1/2 to j's cell (a half whose
   /// particle is outside the box is dropped); a wall record adds
   /// (x_i - p) (x) F_i to i's cell. sigma = (kinetic + contact)/(V_c w_c),
   /// p = tr(sigma)/3, phi = sum V_i/(V_c w_c); cells with w_c = 0 get
@@ -192,6 +196,7 @@ class CellGrid {
   std::vector<double> accessible_;
   CellFields latest_;
   CellFields sum_;                 ///< running sums since the last take (velocity slots hold momentum)
+  PeriodicBox periodic_;  ///< set_periodic()
   std::size_t pending_ = 0;
   std::vector<std::ptrdiff_t> cell_scratch_;  ///< cell of each particle in the current sample
 };

@@ -288,7 +288,12 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
         uint32_t sl = q;
         if constexpr (kMixed) sl = slot_of[q];
         const Load l = load_of(fn_[sl], slots.nx[sl], slots.ny[sl], slots.nz[sl], ftx_[sl], fty_[sl], ftz_[sl]);
-        ts.records.push_back({li[le], lj[le], l.fx, l.fy, l.fz, 0.0, 0.0, 0.0});
+        // the partner's position: j itself, or its image nearest to i through a periodic face
+        const uint32_t i = li[le], j = lj[le];
+        double dx, dy, dz;
+        separation(i, j, dx, dy, dz);
+        const double shift[3] = {(px[i] - px[j]) - dx, (py[i] - py[j]) - dy, (pz[i] - pz[j]) - dz};
+        ts.records.push_back({i, j, l.fx, l.fy, l.fz, px[j] + shift[0], py[j] + shift[1], pz[j] + shift[2]});
       }
     contacts += c;
   }

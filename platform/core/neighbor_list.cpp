@@ -253,6 +253,16 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
       // clamp in double first: an outlier far outside [lo, hi] must not overflow the int cast
       for (int a = 0; a < 3; ++a)
         c[a] = static_cast<int>(std::min(static_cast<double>(dim[a] - 1), std::max(0.0, (p[a] - lo[a]) * inv[a])));
+      // a periodic axis wraps (a particle an exchange hook left past a face
+      // belongs to the cell of its image, whose neighbours hold its partners)
+      if (box_.any())
+        for (int a = 0; a < 3; ++a)
+          if (box_.axis[a]) {
+            const double u = std::floor((p[a] - lo[a]) * inv[a]);
+            if (u >= 0 && u < dim[a]) continue;
+            const double m = std::fmod(u, static_cast<double>(dim[a]));
+            c[a] = static_cast<int>(m < 0 ? m + dim[a] : m);
+          }
     };
     const std::size_t ncell = static_cast<std::size_t>(dim[0]) * dim[1] * dim[2];
     std::vector<uint32_t> start(ncell + 1, 0), order(n);
@@ -455,6 +465,15 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
 
 namespace domel::platform {
 
+namespace {
+/// A periodic box as checkpoints keep it: per axis, periodic (0/1), lo, hi.
+std::vector<double> periodic_record(const PeriodicBox& b) {
+  std::vector<double> v;
+  for (int a = 0; a < 3; ++a) v.insert(v.end(), {b.axis[a] ? 1.0 : 0.0, b.axis[a] ? b.lo[a] : 0.0, b.axis[a] ? b.hi[a] : 0.0});
+  return v;
+}
+}  // namespace
+
 void NeighborList::save(ArchiveWriter& w, const std::string& p) const {
   w.put(p + "i", i);
   w.put(p + "j", j);
@@ -466,6 +485,7 @@ void NeighborList::save(ArchiveWriter& w, const std::string& p) const {
   w.put(p + "built_ids", built_ids_);
   w.put(p + "counters", std::vector<std::uint64_t>{builds_, built_size_, built_version_, near_size_, stride_});
   w.put_scalar(p + "skin", skin_);
+  w.put(p + "periodic", periodic_record(box_));
 }
 
 void NeighborList::load(const ArchiveReader& r, const std::string& p) {
@@ -483,6 +503,9 @@ void NeighborList::load(const ArchiveReader& r, const std::string& p) {
     r.fail(p + "counters", "holds contact histories of " + std::to_string(c[4]) +
                                " values per pair; this scenario's contact model keeps " + std::to_string(stride_));
   if (r.scalar<double>(p + "skin") != skin_) r.fail(p + "skin", "was written with another neighbour-list skin");
+  const std::vector<double> written = r.has(p + "periodic") ? r.get<double>(p + "periodic") : periodic_record({});
+  if (written != periodic_record(box_))
+    r.fail(p + "periodic", "was written with other periodic boundaries (subdomains[].periodic)");
   builds_ = c[0];
   built_size_ = c[1];
   built_version_ = c[2];

@@ -150,8 +150,8 @@ double WallMotion::displacement_bound(double t0, double t1, const std::vector<do
     if (it.kind == MotionItem::Kind::servo && it.servo) {
       // the travel's history is not kept: bound it by the speed limit
       const double e0 = std::clamp(t0, it.start, it.end), e1 = std::clamp(t1, it.start, it.end);
-      bound += it.servo->max_velocity * std::fabs(e1 - e0);
-      cum += std::fabs(it.servo->travel(e1)) + it.servo->max_velocity * std::fabs(e1 - e0);  // >= |travel(e0)|
+      if (e1 != e0) bound += it.servo->max_velocity * std::fabs(e1 - e0);
+      cum += std::fabs(it.servo->travel(e1)) + (e1 != e0 ? it.servo->max_velocity * std::fabs(e1 - e0) : 0.0);  // >= |travel(e0)|
       continue;
     }
     translation_of(it, t1, d1, u);

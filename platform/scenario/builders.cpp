@@ -333,7 +333,7 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
       const Inserter ins = make_inserter(b, block, sub, b.sim.seed * 1000003ull + hash + q);
       ParticleStore& st = sub.store();
       const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
-                                                               b.sim.flow.max_particles);
+                                                               b.sim.flow.max_particles, sub.periodic());
       st.reserve(st.size() + c.size());
       for (std::size_t p = 0; p < c.size(); ++p) {
         st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], ins.density, ins.fixed, ins.material);
@@ -508,12 +508,6 @@ void build_subdomain(Build& b, std::size_t k) {
   sub->set_environment(b.sim.materials, &b, coefficients_of, &b.sim.walls, b.sim.gravity);
   if (b.sim.gravity_schedule) sub->set_gravity(b.sim.gravity_schedule);
 
-  const std::size_t problems_before_insert = b.ck.diags.size();
-  build_initial_state(b, *sub, sd, base);
-  build_insertions(b, *sub, sd, base);
-  std::vector<PourProbe> pour_radii;
-  build_pours(b, *sub, sd, base, pour_radii);
-  if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
   PeriodicBox box;
   if (const json* per = member(sd, "periodic")) {
     for (int a = 0; a < 3; ++a) {
@@ -523,9 +517,15 @@ void build_subdomain(Build& b, std::size_t k) {
       box.lo[a] = (*per)[ax][0].get<double>();
       box.hi[a] = (*per)[ax][1].get<double>();
     }
-    sub->set_periodic(box);
-    box.wrap(sub->store());  // inserted at the faces' edge: inside, as the first list build would have it
+    sub->set_periodic(box);  // before the insertions: they keep clear of the images
   }
+  const std::size_t problems_before_insert = b.ck.diags.size();
+  build_initial_state(b, *sub, sd, base);
+  build_insertions(b, *sub, sd, base);
+  std::vector<PourProbe> pour_radii;
+  build_pours(b, *sub, sd, base, pour_radii);
+  if (b.ck.diags.size() > problems_before_insert) return;  // no time step from a half-built subdomain
+  box.wrap(sub->store());  // a state file's positions past a face: inside, as the first list build would have them
   check_initial_particles(b, *sub, sd, base);
   // The fine level of a coupling starts empty: its particles will be its
   // parent's parcels at its own ratio, which set its skin and time step.
@@ -560,6 +560,17 @@ void build_subdomain(Build& b, std::size_t k) {
                "expected a period of at least twice the neighbour-list cut-off (largest diameter + skin = " +
                    fmt_num(cut) + " m), found " + fmt_num(box.length(a)) + " m",
                "lengthen the periodic box to " + fmt_num(2.0 * cut) + " m or more");
+    // a periodic pipe reaches past both faces by half a skin: between list
+    // rebuilds a particle may stand that far outside the box
+    if (box.axis[a])
+      for (const WallPrimitive& w : b.sim.walls)
+        if (w.shape == WallPrimitive::Shape::cylinder_inside && w.axis == a &&
+            (w.lo > box.lo[a] - 0.5 * sub->skin() || w.hi < box.hi[a] + 0.5 * sub->skin()))
+          b.ck.add(idx("/walls", w.wall),
+                   "a cylinder along the periodic axis " + std::string(1, static_cast<char>('x' + a)) + " of subdomain '" +
+                       sd_name + "' that ends within half a skin (" + fmt_num(0.5 * sub->skin()) +
+                       " m) of the periodic box",
+                   "extend its bottom and top past the box by at least " + fmt_num(0.5 * sub->skin()) + " m");
   }
   {
     double rmin = rmax;

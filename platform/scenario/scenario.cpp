@@ -70,7 +70,7 @@ void check_periodic_axis(const json& doc, int a, double lo, double hi, const std
                             (member(wall, "closed_top") && wall["closed_top"] == true);
         if (!along || closed || b0 > lo || b1 < hi)
           refuse(wb, std::string("a cylinder ") + (!along ? "whose axis is not " + ax : closed ? "with a bottom or lid" : "shorter than the periodic box"),
-                 "a periodic pipe is a cylinder along " + ax + " with \"closed_bottom\": false spanning [lo, hi]");
+                 "a periodic pipe is a cylinder along " + ax + " with \"closed_bottom\": false reaching past both faces");
       } else if (!t.empty()) {
         refuse(wb + "/type", "a " + t + " wall", "only planes, open boxes and open cylinders are invariant along a periodic axis");
       }
@@ -376,6 +376,7 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
       if (const json* mo = member(w, "motion"); mo && (mo->is_object() || mo->is_array())) {
         const json items = mo->is_array() ? *mo : json::array({*mo});
         int servos = 0;
+        const json* servo_dir = nullptr;  // the first servo's direction
         for (std::size_t i = 0; i < items.size(); ++i) {
           const json& m = items[i];
           if (!m.is_object()) continue;
@@ -386,6 +387,9 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
             ck.add(mp + "/end", "expected end > start, found end " + fmt_num(en->get<double>()) + " <= start " +
                                     fmt_num(st->get<double>()));
           if (const json* sv = member(m, "servo")) {
+            if (t == "box" || t == "cylinder" || t == "cone")
+              ck.add(mp + "/servo", "a servo on a " + t + " wall, found one: the loads on its opposite sides cancel",
+                     "put the servo on a plane, disk or mesh wall (a lid) of its own");
             if (++servos == 2)
               ck.add(mp + "/servo", "expected one servo per wall, found a second one",
                      "a wall holds one target force; give the other servo its own wall");
@@ -405,6 +409,22 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
               ck.add(mp + "/servo/direction", "expected a non-zero direction, found [0, 0, 0]");
           }
           const json* om = member(m, "angular_velocity");
+          if (servo_dir && is_vec3(om) && is_vec3(servo_dir)) {
+            // a rotation after a servo would turn the servo's direction away from the one it measures along
+            const double wv[3] = {(*om)[0].get<double>(), (*om)[1].get<double>(), (*om)[2].get<double>()};
+            const double u[3] = {(*servo_dir)[0].get<double>(), (*servo_dir)[1].get<double>(), (*servo_dir)[2].get<double>()};
+            const double c[3] = {wv[1] * u[2] - wv[2] * u[1], wv[2] * u[0] - wv[0] * u[2], wv[0] * u[1] - wv[1] * u[0]};
+            const double wl = std::sqrt(wv[0] * wv[0] + wv[1] * wv[1] + wv[2] * wv[2]);
+            const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (wl > 0 && std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) > 1e-9 * wl * ul)
+              ck.add(mp + "/angular_velocity", "a rotation listed after a servo, about an axis not parallel to the servo's "
+                                               "direction: it would turn the direction the servo measures along",
+                     "list the rotation before the servo");
+          }
+          if (const json* sv = member(m, "servo"); sv && !servo_dir) {
+            const json* dir = member(*sv, "direction");
+            if (is_vec3(dir) && ((*dir)[0] != 0 || (*dir)[1] != 0 || (*dir)[2] != 0)) servo_dir = dir;
+          }
           if (!is_vec3(om) || t == "mesh") continue;
           const double wv[3] = {(*om)[0].get<double>(), (*om)[1].get<double>(), (*om)[2].get<double>()};
           const double wl = std::sqrt(wv[0] * wv[0] + wv[1] * wv[1] + wv[2] * wv[2]);

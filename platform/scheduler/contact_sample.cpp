@@ -44,7 +44,7 @@ void ContactSample::take(std::size_t k, const Subdomain& sd, const std::vector<W
     for (const ContactRecord& c : *list) {
       const bool wall = c.j == ContactRecord::kWall;
       const double xi[3] = {s.x[c.i], s.y[c.i], s.z[c.i]};
-      const double xj[3] = {wall ? c.px : s.x[c.j], wall ? c.py : s.y[c.j], wall ? c.pz : s.z[c.j]};
+      const double xj[3] = {c.px, c.py, c.pz};  // the contact point on a wall; the partner (its nearest image)
       const double f[3] = {c.fx, c.fy, c.fz};
       if (wall) {
         const std::size_t scenario_wall = walls[c.wall].wall;

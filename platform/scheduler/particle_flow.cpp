@@ -33,16 +33,51 @@ double mass_kg(MassUnits u) {
 }
 
 InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
-                                      double alpha, const ParticleStore* present, std::size_t max_count) {
+                                      double alpha, const ParticleStore* present, std::size_t max_count,
+                                      const PeriodicBox& box) {
   domel_insert_request_v1 req{};
   req.struct_size = sizeof(req);
   req.region = region;
   req.seed = seed;
   req.length_scale = alpha;
+  // Periodic axes: the model knows nothing of images, so it also gets the
+  // images, one period away, of the particles within reach of a face
+  // (4 of the largest radii, at most half the period): a new particle near
+  // one face then keeps clear of those near the other.
+  std::vector<double> ix, iy, iz, ir;
   if (present) {
     req.n_existing = present->size();
     req.ex_x = present->x.data(); req.ex_y = present->y.data(); req.ex_z = present->z.data();
     req.ex_r = present->radius.data();
+    if (box.any() && present->size() > 0) {
+      double rmax = 0;
+      for (double r : present->radius) rmax = std::max(rmax, r);
+      const std::vector<double>* pos[3] = {&present->x, &present->y, &present->z};
+      ix = present->x; iy = present->y; iz = present->z; ir = present->radius;
+      for (int sx = -1; sx <= 1; ++sx)
+        for (int sy = -1; sy <= 1; ++sy)
+          for (int sz = -1; sz <= 1; ++sz) {
+            const int sh[3] = {sx, sy, sz};
+            bool ok = sx != 0 || sy != 0 || sz != 0;
+            for (int a = 0; a < 3; ++a) ok = ok && (sh[a] == 0 || box.axis[a]);
+            if (!ok) continue;
+            for (std::size_t k = 0; k < present->size(); ++k) {
+              bool near = true;
+              double p[3];
+              for (int a = 0; a < 3 && near; ++a) {
+                const double v = (*pos[a])[k];
+                p[a] = v + sh[a] * (box.axis[a] ? box.length(a) : 0.0);
+                if (sh[a] == 0) continue;
+                const double reach = std::min(0.5 * box.length(a), 4.0 * rmax);
+                near = sh[a] > 0 ? v < box.lo[a] + reach : v >= box.hi[a] - reach;
+              }
+              if (!near) continue;
+              ix.push_back(p[0]); iy.push_back(p[1]); iz.push_back(p[2]); ir.push_back(present->radius[k]);
+            }
+          }
+      req.n_existing = ix.size();
+      req.ex_x = ix.data(); req.ex_y = iy.data(); req.ex_z = iz.data(); req.ex_r = ir.data();
+    }
   }
   req.max_count = max_count;
   InsertionCandidates c;
@@ -113,7 +148,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   const std::uint64_t seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
   InsertionCandidates c;
   try {
-    c = request_insertion(*p.model, p.region, seed, p.alpha, &st, max_particles);
+    c = request_insertion(*p.model, p.region, seed, p.alpha, &st, max_particles, sd.periodic());
   } catch (const PluginError& e) {
     throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
   }

@@ -45,9 +45,11 @@ struct InsertionCandidates {
 /// particles, radii scaled by alpha, avoiding the particles of `present`
 /// (none when null), with `seed`, at most `max_count` of them (the
 /// scenario's run.max_particles; 0: no limit). Throws PluginError when the
-/// model fails or would place more.
+/// model fails or would place more. Along the periodic axes of `box` the
+/// new particles keep clear of the present ones' images too.
 InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
-                                      double alpha, const ParticleStore* present, std::size_t max_count);
+                                      double alpha, const ParticleStore* present, std::size_t max_count,
+                                      const PeriodicBox& box = {});
 
 /// Exact mass in units of 1e-18 kg (sums in 128 bits).
 using MassUnits = __int128;

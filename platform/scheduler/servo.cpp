@@ -20,7 +20,9 @@ void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>&
     s.measured = 0.0 - (f[0] * s.direction[0] + f[1] * s.direction[1] + f[2] * s.direction[2]);
     const double vmax = s.state->max_velocity;
     const double v = t >= s.start && t < s.end ? std::clamp(s.gain * (s.force - s.measured), -vmax, vmax) : 0.0;
-    s.state->set_velocity(t, v);
+    // past its end the travel stops where it stood at the end (no jump when
+    // the end falls inside a macro step)
+    s.state->set_velocity(std::min(t, s.end), v);
   }
 }
 

@@ -217,6 +217,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (const auto& g : grid_setups) {
     grids.push_back(std::make_unique<CellGrid>(g.spec));
     grids.back()->set_accessible(walls, 0.0);
+    grids.back()->set_periodic(subdomains[g.subdomain]->periodic());
     grid_vtk.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridVtkSeries>(out, g.spec.name) : nullptr);
     grid_csv.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridProfileCsv>(out, g.spec.name, g.profile_axis)
                                                  : nullptr);

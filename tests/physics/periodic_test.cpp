@@ -109,3 +109,34 @@ TEST(Periodic, ASphereSlidingOnAFloorCrossesTheFaceWithItsWallContact) {
   EXPECT_NEAR(std::remainder(per[2] - ref[2], kL), 0.0, 1e-9);
   EXPECT_LT(per[2], kL + 0.5 * 0.2 * kD);
 }
+
+TEST(Periodic, APairThroughTheFaceIsRecordedWithItsPartnersNearestImage) {
+  // Two spheres overlapping by 0.1 mm through the face x = 0 / kL: the
+  // contact record (contact files, the cell grids' contact stress) carries
+  // the partner at its image, one period away, so the branch vector is the
+  // short one, of length 2R - 0.1 mm.
+  json doc = dt::scenario(dt::hertz_mindlin(), 1e-6, 0.5, 0.5);
+  doc["subdomains"][0]["periodic"] = {{"x", {0.0, kL}}};
+  auto sim = dt::build(doc);
+  auto& sd = *sim->subdomains[0];
+  auto& s = sd.store();
+  const double gap = kD - 1e-4;  // centre distance through the face
+  s.add(1, 0.5 * gap, 0.005, 0, kR, kRho);
+  s.add(2, kL - 0.5 * gap, 0.005, 0, kR, kRho);
+  sd.set_time_step(1e-7);
+  sd.set_skin(0.2 * kD);
+  sd.set_record_contacts(true);
+  sd.setup();
+  sd.step();
+  std::size_t pairs = 0;
+  for (const auto* list : sd.contact_records())
+    for (const auto& r : *list) {
+      if (r.j == domel::platform::ContactRecord::kWall) continue;
+      ++pairs;
+      const double l = std::hypot(std::hypot(s.x[r.i] - r.px, s.y[r.i] - r.py), s.z[r.i] - r.pz);
+      EXPECT_NEAR(l, gap, 1e-6) << "the branch vector to the nearest image";
+      EXPECT_NEAR(std::fabs(r.px - s.x[r.j]), kL, 1e-12);
+      EXPECT_GT(std::fabs(r.fx), 0.0);
+    }
+  EXPECT_EQ(pairs, 1u);
+}

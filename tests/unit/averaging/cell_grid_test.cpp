@@ -47,8 +47,9 @@ CellGridSpec box_spec(double lo, double hi, int nx, int ny, int nz) {
 
 const std::vector<const std::vector<ContactRecord>*> kNoRecords;
 
-ContactRecord pair(std::uint32_t i, std::uint32_t j, double fx, double fy, double fz) {
-  return ContactRecord{i, j, fx, fy, fz, 0, 0, 0};
+/// A pair contact of particles i and j of s (partner position: j's own).
+ContactRecord pair(const ParticleStore& s, std::uint32_t i, std::uint32_t j, double fx, double fy, double fz) {
+  return ContactRecord{i, j, fx, fy, fz, s.x[j], s.y[j], s.z[j]};
 }
 
 double sum(const std::vector<double>& v) {
@@ -151,8 +152,8 @@ TEST(CellGrid, ContactStressOfCubicLatticeUnderPairForces) {
     for (int j = 0; j < 4; ++j)
       for (int i = 0; i < 3; ++i) {
         // force on the left particle from its right neighbour: pushes it to -x
-        repulsive.push_back(pair(at(i, j, k), at(i + 1, j, k), -F, 0, 0));
-        attractive.push_back(pair(at(i + 1, j, k), at(i, j, k), -F, 0, 0));  // right one pulled to -x
+        repulsive.push_back(pair(s, at(i, j, k), at(i + 1, j, k), -F, 0, 0));
+        attractive.push_back(pair(s, at(i + 1, j, k), at(i, j, k), -F, 0, 0));  // right one pulled to -x
       }
   const double V = L * L * L;
   grid.sample(s, {&repulsive, nullptr}, 0.0);
@@ -194,7 +195,7 @@ TEST(CellGrid, PairWithOnePartnerOutsideKeepsOnlyTheInsideHalf) {
   s.add(1, 1.1, 0.5, 0.5, 0.1, 1000);  // outside (x >= hi)
   s.add(2, 1.0, 0.5, 0.5, 0.1, 1000);  // on hi: outside, bins are [lo, hi)
   s.vx = {0, 5, 5};
-  std::vector<ContactRecord> rec = {pair(0, 1, -2.0, 0, 0)};  // repulsive, |l| = 0.2
+  std::vector<ContactRecord> rec = {pair(s, 0, 1, -2.0, 0, 0)};  // repulsive, |l| = 0.2
   grid.sample(s, {&rec}, 0.0);
   const CellFields& f = grid.latest();
   EXPECT_EQ(f.count[0], 1);
@@ -337,6 +338,6 @@ TEST(CellGrid, RejectsBadSpecAndRecords) {
   EXPECT_FALSE(grid.due(31));
   ParticleStore s;
   s.add(0, 0.5, 0.5, 0.5, 0.1, 1000);
-  std::vector<ContactRecord> rec = {pair(0, 7, 1, 0, 0)};
+  std::vector<ContactRecord> rec = {ContactRecord{0, 7, 1, 0, 0, 0, 0, 0}};  // 7: out of range
   EXPECT_THROW(grid.sample(s, {&rec}, 0.0), RuntimeError);
 }

@@ -86,7 +86,7 @@ CellGrid make_sampled_grid(const std::string& name) {
   s.vx[0] = 1;
   s.vy[0] = 2;
   s.vz[0] = 3;
-  std::vector<ContactRecord> rec = {ContactRecord{1, 2, -5.0, 0, 0, 0, 0, 0}};
+  std::vector<ContactRecord> rec = {ContactRecord{1, 2, -5.0, 0, 0, s.x[2], s.y[2], s.z[2]}};
   grid.sample(s, {&rec}, 0.25);
   return grid;
 }
