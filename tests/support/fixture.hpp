@@ -10,8 +10,14 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <unistd.h>
+#include <vector>
 
 namespace domel::test {
 
@@ -58,6 +64,51 @@ inline std::unique_ptr<platform::Simulation> build(const nlohmann::json& doc) {
 inline void add_plane(nlohmann::json& doc, const std::string& name, const std::array<double, 3>& point,
                       const std::array<double, 3>& normal) {
   doc["walls"].push_back({{"name", name}, {"type", "plane"}, {"material", "m"}, {"point", point}, {"normal", normal}});
+}
+
+/// A CSV file of numbers with a header (probes.csv, a grid's profile):
+/// column index by name, and the rows.
+struct Csv {
+  std::map<std::string, std::size_t> column;
+  std::vector<std::vector<double>> rows;
+  double at(std::size_t row, const std::string& name) const { return rows[row][column.at(name)]; }
+};
+
+inline Csv read_csv(const std::filesystem::path& file) {
+  Csv out;
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  {
+    std::stringstream hs(line);
+    std::string n;
+    for (std::size_t k = 0; std::getline(hs, n, ','); ++k) out.column[n] = k;
+  }
+  while (std::getline(in, line)) {
+    std::vector<double> f;
+    std::stringstream ls(line);
+    std::string x;
+    while (std::getline(ls, x, ',')) f.push_back(std::stod(x));
+    out.rows.push_back(std::move(f));
+  }
+  return out;
+}
+
+/// Run a scenario document (as if read from `file`, which paths in it are
+/// relative to) on `threads` threads, without progress, into a fresh
+/// temporary folder named after `name` and the process; returns the folder.
+inline std::filesystem::path run_into_temp(const nlohmann::json& doc, const std::string& file, const std::string& name,
+                                           int threads) {
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("domel_" + name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(out);
+  auto sim = platform::load_scenario(doc, file, builtin_registry());
+  platform::RunOptions opt;
+  opt.output_directory = out;
+  opt.progress = false;
+  opt.threads = threads;
+  sim->run(opt, builtin_registry());
+  return out;
 }
 
 }  // namespace domel::test

@@ -47,39 +47,18 @@ Profile run_chute(double lx_d) {
   for (auto& ins : sd["insert"]) ins["region"]["box"]["max"][0] = L;
   doc["output"]["grids"][0]["max"][0] = L;
   doc["output"]["vtk_interval"] = 0;
-  const fs::path out = fs::temp_directory_path() / ("domel_chute_" + std::to_string(getpid()) + "_" +
-                                                    std::to_string(static_cast<int>(lx_d)));
-  fs::remove_all(out);
-  auto sim = domel::platform::load_scenario(doc, DOMEL_SOURCE_DIR "/scenarios/validation/chute.json",
-                                            dt::builtin_registry());
-  domel::platform::RunOptions opt;
-  opt.output_directory = out;
-  opt.progress = false;
-  opt.threads = 2;
-  sim->run(opt, dt::builtin_registry());
+  const fs::path out = dt::run_into_temp(doc, DOMEL_SOURCE_DIR "/scenarios/validation/chute.json",
+                                         "chute_" + std::to_string(static_cast<int>(lx_d)), 2);
   const double t_from = doc["run"]["duration"].get<double>() - 1.0 + 1e-9;
-
-  std::ifstream csv(out / "profile_profile.csv");
-  std::string line;
-  std::getline(csv, line);
-  std::map<std::string, std::size_t> col;
-  {
-    std::stringstream hs(line);
-    std::string n;
-    for (std::size_t k = 0; std::getline(hs, n, ','); ++k) col[n] = k;
-  }
+  const dt::Csv csv = dt::read_csv(out / "profile_profile.csv");
   std::map<int, std::vector<double>> sum;  // layer -> z, v, phi, samples
-  while (std::getline(csv, line)) {
-    std::vector<double> f;
-    std::stringstream ls(line);
-    std::string x;
-    while (std::getline(ls, x, ',')) f.push_back(std::stod(x));
-    if (f[col.at("time")] < t_from) continue;
-    auto& s = sum[static_cast<int>(f[col.at("layer")])];
+  for (std::size_t r = 0; r < csv.rows.size(); ++r) {
+    if (csv.at(r, "time") < t_from) continue;
+    auto& s = sum[static_cast<int>(csv.at(r, "layer"))];
     if (s.empty()) s.assign(4, 0.0);
-    s[0] = f[col.at("centre")];
-    s[1] += f[col.at("vx")];
-    s[2] += f[col.at("volume_fraction")];
+    s[0] = csv.at(r, "centre");
+    s[1] += csv.at(r, "vx");
+    s[2] += csv.at(r, "volume_fraction");
     s[3] += 1;
   }
   Profile p;

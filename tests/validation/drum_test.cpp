@@ -38,35 +38,13 @@ TEST(Drum, TheDrumsTorqueIsTheMomentOfTheBedsWeightAndItCarriesTheWeight) {
   json doc = json::parse(in);
   doc["run"]["duration"] = 1.5;  // turning from 0.3 s, steady from about 0.6 s
   doc["output"].erase("contacts");
-  const fs::path out = fs::temp_directory_path() / ("domel_drum_" + std::to_string(getpid()));
-  fs::remove_all(out);
-  auto sim = domel::platform::load_scenario(doc, DOMEL_SOURCE_DIR "/scenarios/examples/drum.json",
-                                            dt::builtin_registry());
-  domel::platform::RunOptions opt;
-  opt.output_directory = out;
-  opt.progress = false;
-  opt.threads = 2;
-  sim->run(opt, dt::builtin_registry());
+  const fs::path out = dt::run_into_temp(doc, DOMEL_SOURCE_DIR "/scenarios/examples/drum.json", "drum", 2);
 
   // probes.csv: time -> (torque, force_z)
   std::map<double, std::pair<double, double>> rows;
-  std::ifstream csv(out / "probes.csv");
-  std::string line;
-  std::getline(csv, line);
-  std::vector<std::string> names;
-  {
-    std::stringstream hs(line);
-    std::string n;
-    while (std::getline(hs, n, ',')) names.push_back(n);
-  }
-  while (std::getline(csv, line)) {
-    std::stringstream vs(line);
-    std::string v;
-    std::map<std::string, double> r;
-    for (const auto& n : names)
-      if (std::getline(vs, v, ',')) r[n] = std::stod(v);
-    rows[r["time"]] = {r.at("drum.torque"), r.at("drum.force_z")};
-  }
+  const dt::Csv csv = dt::read_csv(out / "probes.csv");
+  for (std::size_t r = 0; r < csv.rows.size(); ++r)
+    rows[csv.at(r, "time")] = {csv.at(r, "drum.torque"), csv.at(r, "drum.force_z")};
   const double g = 9.81;
   double torque = 0, moment = 0, force = 0, weight = 0;
   int frames = 0;

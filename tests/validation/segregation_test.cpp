@@ -47,37 +47,13 @@ Series run(bool equal_sizes) {
     large["diameter"] = 3e-3;
     large["count"] = large["count"].get<int>() * 8;  // the same volume
   }
-  const fs::path out = fs::temp_directory_path() /
-                       ("domel_shaker_" + std::to_string(getpid()) + (equal_sizes ? "_equal" : ""));
+  const fs::path out = dt::run_into_temp(doc, DOMEL_SOURCE_DIR "/scenarios/examples/shaker.json",
+                                         equal_sizes ? "shaker_equal" : "shaker", 2);
+  const dt::Csv csv = dt::read_csv(out / "probes.csv");
+  const std::vector<std::vector<double>>& rows = csv.rows;
   fs::remove_all(out);
-  auto sim = domel::platform::load_scenario(doc, DOMEL_SOURCE_DIR "/scenarios/examples/shaker.json",
-                                            dt::builtin_registry());
-  domel::platform::RunOptions opt;
-  opt.output_directory = out;
-  opt.progress = false;
-  opt.threads = 2;
-  sim->run(opt, dt::builtin_registry());
-
-  std::ifstream csv(out / "probes.csv");
-  std::string line;
-  std::getline(csv, line);
-  std::map<std::string, std::size_t> col;
-  {
-    std::stringstream hs(line);
-    std::string n;
-    for (std::size_t k = 0; std::getline(hs, n, ','); ++k) col[n] = k;
-  }
-  std::vector<std::vector<double>> rows;
-  while (std::getline(csv, line)) {
-    std::vector<double> f;
-    std::stringstream ls(line);
-    std::string x;
-    while (std::getline(ls, x, ',')) f.push_back(std::stod(x));
-    rows.push_back(f);
-  }
-  fs::remove_all(out);
-  const std::size_t t = col.at("time"), zl = col.at("large.com_z"), zs = col.at("small.com_z"),
-                    ml = col.at("large.mass_kg"), ms = col.at("small.mass_kg");
+  const std::size_t t = csv.column.at("time"), zl = csv.column.at("large.com_z"), zs = csv.column.at("small.com_z"),
+                    ml = csv.column.at("large.mass_kg"), ms = csv.column.at("small.mass_kg");
   double h0 = 0, n0 = 0;
   for (const auto& r : rows)
     if (r[t] > 0.3 && r[t] <= 0.5) {
