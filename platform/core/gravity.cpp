@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "core/gravity.hpp"
 
+#include "core/rotation.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -55,14 +57,9 @@ void GravitySchedule::at(double t, double g[3]) const {
       return;
     }
     case Kind::rotating: {
-      // Rodrigues: g = g0 cos + (k x g0) sin + k (k . g0)(1 - cos)
-      const double angle = rate_ * std::max(0.0, std::min(t, end_) - start_);
-      const double c = std::cos(angle), s = std::sin(angle);
-      const double* g0 = rows_[0].data() + 1;
-      const double* k = axis_;
-      const double kg = k[0] * g0[0] + k[1] * g0[1] + k[2] * g0[2];
-      const double kx[3] = {k[1] * g0[2] - k[2] * g0[1], k[2] * g0[0] - k[0] * g0[2], k[0] * g0[1] - k[1] * g0[0]};
-      for (int a = 0; a < 3; ++a) g[a] = g0[a] * c + kx[a] * s + k[a] * kg * (1.0 - c);
+      double R[9];
+      rotation_matrix(axis_, rate_ * std::max(0.0, std::min(t, end_) - start_), R);
+      mat_vec(R, rows_[0].data() + 1, g);
       return;
     }
   }

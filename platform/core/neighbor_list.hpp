@@ -12,6 +12,7 @@
 #include "core/particle_store.hpp"
 #include "core/thread_pool.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -40,6 +41,16 @@ struct PeriodicBox {
   }
   /// Wrap the particles' positions into the box (returns how many moved).
   std::size_t wrap(ParticleStore& s) const;
+  /// The shifts (-1, 0 or +1 period per axis, 0 along the others) to the
+  /// images one period away, the zero shift not included.
+  std::vector<std::array<int, 3>> image_shifts() const {
+    std::vector<std::array<int, 3>> out;
+    for (int sx = -1; sx <= 1; ++sx)
+      for (int sy = -1; sy <= 1; ++sy)
+        for (int sz = -1; sz <= 1; ++sz)
+          if ((sx || sy || sz) && (!sx || axis[0]) && (!sy || axis[1]) && (!sz || axis[2])) out.push_back({sx, sy, sz});
+    return out;
+  }
 };
 
 /// The nearest image of a separation d along an axis of period L (0: none).

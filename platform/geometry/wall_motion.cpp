@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "geometry/wall_motion.hpp"
 
+#include "core/rotation.hpp"
+
 #include <algorithm>
 
 namespace domel::platform {
@@ -8,18 +10,6 @@ namespace domel::platform {
 namespace {
 
 double norm(const double v[3]) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
-
-/// Rotation by `angle` about the unit axis k (Rodrigues' formula), row-major.
-void rotation_matrix(const double k[3], double angle, double R[9]) {
-  const double c = std::cos(angle), s = std::sin(angle), t = 1.0 - c;
-  R[0] = c + k[0] * k[0] * t;        R[1] = k[0] * k[1] * t - k[2] * s; R[2] = k[0] * k[2] * t + k[1] * s;
-  R[3] = k[1] * k[0] * t + k[2] * s; R[4] = c + k[1] * k[1] * t;        R[5] = k[1] * k[2] * t - k[0] * s;
-  R[6] = k[2] * k[0] * t - k[1] * s; R[7] = k[2] * k[1] * t + k[0] * s; R[8] = c + k[2] * k[2] * t;
-}
-
-void mat_vec(const double M[9], const double v[3], double out[3]) {
-  for (int a = 0; a < 3; ++a) out[a] = M[3 * a] * v[0] + M[3 * a + 1] * v[1] + M[3 * a + 2] * v[2];
-}
 
 /// A translating item's displacement and velocity at t.
 void translation_of(const MotionItem& it, double t, double d[3], double u[3]) {

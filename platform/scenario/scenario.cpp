@@ -4,6 +4,8 @@
 // filled document by builders.cpp.
 #include "scenario/scenario.hpp"
 
+#include "core/rotation.hpp"
+
 #include "geometry/region.hpp"
 #include "geometry/triangle_mesh.hpp"
 #include "io/particle_state.hpp"
@@ -413,10 +415,7 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
             // a rotation after a servo would turn the servo's direction away from the one it measures along
             const double wv[3] = {(*om)[0].get<double>(), (*om)[1].get<double>(), (*om)[2].get<double>()};
             const double u[3] = {(*servo_dir)[0].get<double>(), (*servo_dir)[1].get<double>(), (*servo_dir)[2].get<double>()};
-            const double c[3] = {wv[1] * u[2] - wv[2] * u[1], wv[2] * u[0] - wv[0] * u[2], wv[0] * u[1] - wv[1] * u[0]};
-            const double wl = std::sqrt(wv[0] * wv[0] + wv[1] * wv[1] + wv[2] * wv[2]);
-            const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            if (wl > 0 && std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) > 1e-9 * wl * ul)
+            if (!parallel(wv, u))
               ck.add(mp + "/angular_velocity", "a rotation listed after a servo, about an axis not parallel to the servo's "
                                                "direction: it would turn the direction the servo measures along",
                      "list the rotation before the servo");
@@ -438,13 +437,10 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
             ax[axis_index(member(w, "axis"))] = 1.0;
             have_axis = true;
           }
-          const double al = std::sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
-          const double c[3] = {wv[1] * ax[2] - wv[2] * ax[1], wv[2] * ax[0] - wv[0] * ax[2], wv[0] * ax[1] - wv[1] * ax[0]};
           if (wl > 0 && t == "box") {
             ck.add(mp + "/angular_velocity", "a box wall cannot rotate, found a non-zero angular_velocity",
                    "use a mesh wall for a rotating box, or only a velocity");
-          } else if (wl > 0 && have_axis && al > 0 &&
-                     std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) > 1e-9 * wl * al) {
+          } else if (wl > 0 && have_axis && !parallel(wv, ax)) {
             ck.add(mp + "/angular_velocity",
                    "a " + t + " wall rotates only about an axis parallel to its own " +
                        (t == "plane" || t == "disk" ? "normal" : "axis") + ", found angular_velocity [" +

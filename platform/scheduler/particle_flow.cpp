@@ -54,27 +54,21 @@ InsertionCandidates request_insertion(const ModelInstance& model, const domel_re
       for (double r : present->radius) rmax = std::max(rmax, r);
       const std::vector<double>* pos[3] = {&present->x, &present->y, &present->z};
       ix = present->x; iy = present->y; iz = present->z; ir = present->radius;
-      for (int sx = -1; sx <= 1; ++sx)
-        for (int sy = -1; sy <= 1; ++sy)
-          for (int sz = -1; sz <= 1; ++sz) {
-            const int sh[3] = {sx, sy, sz};
-            bool ok = sx != 0 || sy != 0 || sz != 0;
-            for (int a = 0; a < 3; ++a) ok = ok && (sh[a] == 0 || box.axis[a]);
-            if (!ok) continue;
-            for (std::size_t k = 0; k < present->size(); ++k) {
-              bool near = true;
-              double p[3];
-              for (int a = 0; a < 3 && near; ++a) {
-                const double v = (*pos[a])[k];
-                p[a] = v + sh[a] * (box.axis[a] ? box.length(a) : 0.0);
-                if (sh[a] == 0) continue;
-                const double reach = std::min(0.5 * box.length(a), 4.0 * rmax);
-                near = sh[a] > 0 ? v < box.lo[a] + reach : v >= box.hi[a] - reach;
-              }
-              if (!near) continue;
-              ix.push_back(p[0]); iy.push_back(p[1]); iz.push_back(p[2]); ir.push_back(present->radius[k]);
-            }
+      for (const auto& sh : box.image_shifts())
+        for (std::size_t k = 0; k < present->size(); ++k) {
+          bool near = true;
+          double p[3];
+          for (int a = 0; a < 3 && near; ++a) {
+            const double v = (*pos[a])[k];
+            p[a] = v + sh[a] * (box.axis[a] ? box.length(a) : 0.0);
+            if (sh[a] == 0) continue;
+            const double reach = std::min(0.5 * box.length(a), 4.0 * rmax);
+            near = sh[a] > 0 ? v < box.lo[a] + reach : v >= box.hi[a] - reach;
           }
+          if (near) {
+            ix.push_back(p[0]); iy.push_back(p[1]); iz.push_back(p[2]); ir.push_back(present->radius[k]);
+          }
+        }
       req.n_existing = ix.size();
       req.ex_x = ix.data(); req.ex_y = iy.data(); req.ex_z = iz.data(); req.ex_r = ir.data();
     }

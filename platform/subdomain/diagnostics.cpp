@@ -104,15 +104,9 @@ InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit, cons
     cells[key(coord(s.x[k], 0), coord(s.y[k], 1), coord(s.z[k], 2))].push_back(static_cast<std::uint32_t>(k));
   std::vector<InitialOverlaps::Pair> above;
   // periodic axes: the images of each particle one period away on either side
-  std::vector<std::array<double, 3>> shifts;
-  for (int sx = -1; sx <= 1; ++sx)
-    for (int sy = -1; sy <= 1; ++sy)
-      for (int sz = -1; sz <= 1; ++sz) {
-        const int sh[3] = {sx, sy, sz};
-        bool ok = true;
-        for (int a = 0; a < 3; ++a) ok = ok && (sh[a] == 0 || box.axis[a]);
-        if (ok) shifts.push_back({sx * box.length(0), sy * box.length(1), sz * box.length(2)});
-      }
+  std::vector<std::array<double, 3>> shifts = {{0.0, 0.0, 0.0}};
+  for (const auto& sh : box.image_shifts())
+    shifts.push_back({sh[0] * box.length(0), sh[1] * box.length(1), sh[2] * box.length(2)});
   for (std::size_t p = 0; p < n; ++p)
     for (const auto& shift : shifts) {
     const double xp = s.x[p] + shift[0], yp = s.y[p] + shift[1], zp = s.z[p] + shift[2];

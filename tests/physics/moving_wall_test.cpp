@@ -29,13 +29,8 @@ TEST(MovingWall, BeltDragsARestingSphereToTwoSeventhsOfItsSpeed) {
   doc["walls"].push_back({{"name", "belt"}, {"type", "plane"}, {"material", "m"}, {"point", {0, 0, 0}},
                           {"normal", {0, 0, 1}}, {"motion", {{"velocity", {U, 0, 0}}, {"start", 0.02}}}});
   auto sim = dt::build(doc);
-  auto& sd = *sim->subdomains[0];
+  auto& sd = dt::one_sphere(*sim, {0, 0, kR}, kR, kRho);
   auto& s = sd.store();
-  s.add(1, 0, 0, kR, kR, kRho);
-  const auto rep = sd.estimate_time_step(0.1);
-  sd.set_time_step(std::min(rep.contact_time / 50.0, 2e-5));
-  sd.set_skin(0.2 * kD);
-  sd.setup();
   while (sd.time() < 0.02) sd.step();  // settle on the still belt
   EXPECT_LT(std::fabs(s.vx[0]), 1e-4);
   const double t_star = 2 * U / (7 * kMu * kG);
@@ -62,13 +57,8 @@ TEST(MovingWall, RotatingCylinderSpinsUpASphereAtItsWall) {
                           {"center", {0, 0, 0}}, {"radius", R}, {"bottom", 0.0}, {"top", 0.02},
                           {"motion", {{"angular_velocity", {0, 0, omega}}}}});
   auto sim = dt::build(doc);
-  auto& sd = *sim->subdomains[0];
+  auto& sd = dt::one_sphere(*sim, {R - kR, 0, kR}, kR, kRho);
   auto& s = sd.store();
-  s.add(1, R - kR, 0, kR, kR, kRho);
-  const auto rep = sd.estimate_time_step(0.1);
-  sd.set_time_step(std::min(rep.contact_time / 50.0, 2e-5));
-  sd.set_skin(0.2 * kD);
-  sd.setup();
   while (sd.time() < 0.3) sd.step();
   const double rho = std::hypot(s.x[0], s.y[0]);
   const double v_tangential = (s.x[0] * s.vy[0] - s.y[0] * s.vx[0]) / rho;  // positive: counter-clockwise, as omega

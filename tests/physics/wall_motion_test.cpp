@@ -32,13 +32,8 @@ double vibrated_plate_takeoff(double gamma, double f, double periods, double you
                           {"motion", {{"vibration", {{"amplitude", {0, 0, A}}, {"frequency", f}, {"phase", -M_PI / 2}}},
                                       {"start", t0}}}});
   auto sim = dt::build(doc);
-  auto& sd = *sim->subdomains[0];
+  auto& sd = dt::one_sphere(*sim, {0, 0, kR}, kR, kRho);
   auto& s = sd.store();
-  s.add(1, 0, 0, kR, kR, kRho);
-  const auto rep = sd.estimate_time_step(0.1);
-  sd.set_time_step(std::min(rep.contact_time / 50.0, 2e-5));
-  sd.set_skin(0.2 * kD);
-  sd.setup();
   while (sd.time() < t0) sd.step();  // settle on the still plate
   EXPECT_EQ(sd.stats().wall_contacts, 1u);
   while (sd.time() < t0 + periods / f) {
@@ -82,13 +77,8 @@ TEST(ServoWall, ALidComesToRestWhereItCarriesTheTargetForce) {
                           {"motion", {{"servo", {{"direction", {0, 0, -1}}, {"force", target}, {"max_velocity", 0.05}}}}}});
   auto sim = dt::build(doc);
   ASSERT_EQ(sim->servos.servos.size(), 1u);
-  auto& sd = *sim->subdomains[0];
+  auto& sd = dt::one_sphere(*sim, {0, 0, kR}, kR, kRho);
   auto& s = sd.store();
-  s.add(1, 0, 0, kR, kR, kRho);
-  const auto rep = sd.estimate_time_step(0.1);
-  sd.set_time_step(std::min(rep.contact_time / 50.0, 2e-5));
-  sd.set_skin(0.2 * kD);
-  sd.setup();
   while (sd.time() < 0.03) {
     sd.step();
     sim->servos.update(sd.time(), sim->subdomains);  // what the run loop does after every macro step
