@@ -9,13 +9,23 @@
 
 namespace domel::platform {
 
-ContactPipeline::ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots)
-    : slots_(std::move(slots)) {
+ContactPipeline::ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots,
+                                 std::vector<std::unique_ptr<ModelInstance>> pair_rolling)
+    : slots_(std::move(slots)), pair_rolling_(std::move(pair_rolling)) {
   for (std::size_t s = 0; s < kSlotCount; ++s) {
     offset_[s] = history_stride_;
-    if (slots_[s]) history_stride_ += slots_[s]->history_slots();
+    uint32_t slice = slots_[s] ? slots_[s]->history_slots() : 0;
     if (slots_[s] && slots_[s]->reads_masses()) reads_masses_ = true;
+    if (s == static_cast<std::size_t>(Slot::rolling))
+      for (const auto& m : pair_rolling_)
+        if (m) {
+          slice = std::max(slice, m->history_slots());
+          reads_masses_ = reads_masses_ || m->reads_masses();
+          has_rolling_ = true;
+        }
+    history_stride_ += slice;
   }
+  has_rolling_ = has_rolling_ || slots_[static_cast<int>(Slot::rolling)];
   main_ = make_workspace();
 }
 
@@ -59,21 +69,22 @@ ContactPipeline::Workspace::Workspace(uint32_t history_stride) {
   b.rolling_damping = buf.rolling_damping.data();
 }
 
-void ContactPipeline::evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const {
+void ContactPipeline::evaluate(Workspace& ws, const domel_pair_v2& pair, const ModelInstance* rolling, double dt,
+                               uint32_t n) const {
   ws.batch.pair = &pair;  // one pair for the batch: read once per batch by the kernels (abi.h)
   ws.batch.pair_of = nullptr;
-  run_stages(ws.batch, ws.buf.history.data(), dt, n);
+  run_stages(ws.batch, ws.buf.history.data(), rolling, dt, n);
 }
 
 void ContactPipeline::evaluate(Workspace& ws, double dt, uint32_t n) const {
   ws.batch.pair = nullptr;
   ws.batch.pair_of = ws.buf.pair_of.data();
-  run_stages(ws.batch, ws.buf.history.data(), dt, n);
+  run_stages(ws.batch, ws.buf.history.data(), slot(Slot::rolling), dt, n);
 }
 
-void ContactPipeline::evaluate_range(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t first,
-                                     uint32_t n) const {
-  if (first == 0) return evaluate(ws, pair, dt, n);
+void ContactPipeline::evaluate_range(Workspace& ws, const domel_pair_v2& pair, const ModelInstance* rolling,
+                                     double dt, uint32_t first, uint32_t n) const {
+  if (first == 0) return evaluate(ws, pair, rolling, dt, n);
   domel_contact_batch_v2 b = ws.batch;  // the same arrays, from contact `first` on
   b.pair = &pair;
   b.pair_of = nullptr;
@@ -83,14 +94,15 @@ void ContactPipeline::evaluate_range(Workspace& ws, const domel_pair_v2& pair, d
   for (double** p : {&b.fn_elastic, &b.kn, &b.kn_tangent, &b.contact_radius, &b.fn_damping, &b.eta_n, &b.fn, &b.ftx,
                      &b.fty, &b.ftz, &b.tqx, &b.tqy, &b.tqz, &b.rolling_stiffness, &b.rolling_damping})
     *p += first;
-  run_stages(b, ws.buf.history.data() + static_cast<std::size_t>(first) * history_stride_, dt, n);
+  run_stages(b, ws.buf.history.data() + static_cast<std::size_t>(first) * history_stride_, rolling, dt, n);
 }
 
-void ContactPipeline::run_stages(domel_contact_batch_v2& b, double* history, double dt, uint32_t n) const {
+void ContactPipeline::run_stages(domel_contact_batch_v2& b, double* history, const ModelInstance* rolling, double dt,
+                                 uint32_t n) const {
   b.n = n;
   b.dt = dt;
   auto run = [&](Slot s) {
-    const auto& inst = slots_[static_cast<int>(s)];
+    const ModelInstance* inst = s == Slot::rolling ? rolling : slots_[static_cast<int>(s)].get();
     if (!inst) return;
     b.history = history + offset_[static_cast<int>(s)];
     inst->contact(b);
@@ -104,7 +116,7 @@ void ContactPipeline::run_stages(domel_contact_batch_v2& b, double* history, dou
     std::fill_n(b.tqy, n, 0.0);
     std::fill_n(b.tqz, n, 0.0);
   }
-  if (slots_[static_cast<int>(Slot::rolling)]) {
+  if (has_rolling_) {  // a pair without a rolling model reports none
     std::fill_n(b.rolling_stiffness, n, 0.0);
     std::fill_n(b.rolling_damping, n, 0.0);
   }

@@ -8,8 +8,9 @@
 // Callers fill the input arrays of a Workspace for up to kBatchSize contacts
 // (and their history rows; the masses when reads_masses(): mass_j = 0 for a
 // wall), call
-// evaluate(workspace, pair, dt, n) when every contact shares one material
-// pair (today always: the batch then carries the pair once, abi.h), or
+// evaluate(workspace, pair, rolling, dt, n) when every contact shares one
+// material pair (the batch then carries the pair once, abi.h; `rolling` is
+// the pair's rolling model), or
 // evaluate(workspace, dt, n) after filling buf.pair_of per contact, grouped
 // by pair, for a batch of several pairs; then read fn and the tangential
 // force and torque outputs. The slot instances are
@@ -33,14 +34,28 @@ class ContactPipeline {
  public:
   static constexpr uint32_t kBatchSize = 256;
 
-  /// normal, damping and tangential are required; rolling and twisting may be null.
-  explicit ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots);
+  /// normal, damping and tangential are required; rolling and twisting may
+  /// be null. `pair_rolling`: the rolling models that material pairs name in
+  /// place of the rolling slot's (interactions[].rolling), indexed as
+  /// rolling_model() takes them; they share the rolling slot's slice of the
+  /// history, as long as the longest of them.
+  explicit ContactPipeline(std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots,
+                           std::vector<std::unique_ptr<ModelInstance>> pair_rolling = {});
+
+  /// PairCoefficients::rolling_model of a pair: the rolling slot's model
+  /// (kSubdomainRolling), none (kNoRolling, null) or pair model k.
+  static constexpr int kSubdomainRolling = -1;
+  static constexpr int kNoRolling = -2;
+  const ModelInstance* rolling_model(int k) const {
+    if (k == kSubdomainRolling) return slot(Slot::rolling);
+    return k >= 0 ? pair_rolling_.at(static_cast<std::size_t>(k)).get() : nullptr;
+  }
 
   uint32_t history_stride() const { return history_stride_; }
   const ModelInstance* slot(Slot s) const { return slots_[static_cast<int>(s)].get(); }
-  /// A rolling or twisting model fills the torque couples (tqx, tqy, tqz);
-  /// without one they stay zero.
-  bool has_torque() const { return slots_[static_cast<int>(Slot::rolling)] || slots_[static_cast<int>(Slot::twisting)]; }
+  /// A rolling or twisting model (of the slot or of a pair) fills the torque
+  /// couples (tqx, tqy, tqz); without one they stay zero.
+  bool has_torque() const { return has_rolling_ || slots_[static_cast<int>(Slot::twisting)]; }
   /// Whether some stage reads the batch's mass_i/mass_j; when none does,
   /// the gathers leave them unfilled (abi.h, DOMEL_CONTACT_IGNORES_MASSES).
   bool reads_masses() const { return reads_masses_; }
@@ -88,27 +103,42 @@ class ContactPipeline {
   };
   std::unique_ptr<Workspace> make_workspace() const { return std::make_unique<Workspace>(history_stride_); }
 
-  /// Evaluate all stages on the first n contacts of a workspace, all of one material pair.
-  void evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const;
-  /// The same for a batch of several pairs: contact c uses *ws.buf.pair_of[c].
+  /// Evaluate all stages on the first n contacts of a workspace, all of one
+  /// material pair, whose rolling model is `rolling` (rolling_model() of
+  /// the pair; null: none).
+  void evaluate(Workspace& ws, const domel_pair_v2& pair, const ModelInstance* rolling, double dt, uint32_t n) const;
+  /// The same with the rolling slot's model.
+  void evaluate(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t n) const {
+    evaluate(ws, pair, slot(Slot::rolling), dt, n);
+  }
+  /// The same for a batch of several pairs: contact c uses *ws.buf.pair_of[c]
+  /// (and the rolling slot's model).
   void evaluate(Workspace& ws, double dt, uint32_t n) const;
   /// Evaluate contacts [first, first + n) of a workspace, all of one pair:
   /// a run of a batch grouped by material pair (the kernels see a batch
   /// that starts at `first`).
-  void evaluate_range(Workspace& ws, const domel_pair_v2& pair, double dt, uint32_t first, uint32_t n) const;
+  void evaluate_range(Workspace& ws, const domel_pair_v2& pair, const ModelInstance* rolling, double dt,
+                      uint32_t first, uint32_t n) const;
 
   /// The pipeline's own workspace, for single-threaded callers.
   Buffers& buffers() { return main_->buf; }
   void evaluate(const domel_pair_v2& pair, double dt, uint32_t n) { evaluate(*main_, pair, dt, n); }
+  void evaluate(const domel_pair_v2& pair, const ModelInstance* rolling, double dt, uint32_t n) {
+    evaluate(*main_, pair, rolling, dt, n);
+  }
 
  private:
   std::array<std::unique_ptr<ModelInstance>, kSlotCount> slots_;
+  std::vector<std::unique_ptr<ModelInstance>> pair_rolling_;
   std::array<uint32_t, kSlotCount> offset_{};
   uint32_t history_stride_ = 0;
   bool reads_masses_ = false;
+  bool has_rolling_ = false;  ///< the slot or some pair has a rolling model
   std::unique_ptr<Workspace> main_;
-  /// The stages on batch b (its arrays may start inside the workspace's).
-  void run_stages(domel_contact_batch_v2& b, double* history, double dt, uint32_t n) const;
+  /// The stages on batch b (its arrays may start inside the workspace's),
+  /// with `rolling` in the rolling slot.
+  void run_stages(domel_contact_batch_v2& b, double* history, const ModelInstance* rolling, double dt,
+                  uint32_t n) const;
 };
 
 }  // namespace domel::platform

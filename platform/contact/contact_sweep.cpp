@@ -200,14 +200,13 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
       c += in;
     }
     if (c == 0) continue;
-    // Several materials: the batch's contacts grouped by material pair, so
-    // that each run of one pair is evaluated with its own constants.
+    // Several classes of material pairs: the batch's contacts grouped by
+    // class, so that each run is evaluated with its own constants.
     const uint8_t* __restrict mat = s.material.data();
     const uint32_t nm = sw.n_materials;
     if constexpr (kMixed)
-      group_by_key(c, nm * nm, [&](uint32_t q) {
-        const uint32_t a = mat[li[entry[q]]], b = mat[lj[entry[q]]];
-        return a < b ? a * nm + b : b * nm + a;  // (a, b) and (b, a) share their constants: one run
+      group_by_key(c, sw.n_classes, [&](uint32_t q) {
+        return static_cast<uint32_t>(sw.pair_class[mat[li[entry[q]]] * nm + mat[lj[entry[q]]]]);
       }, ts.key_count, ts.sorted, ts.runs);
     const uint32_t* slot_of = ts.sorted.data();
     // Phase B: the gather (contact geometry and relative velocities) of
@@ -245,10 +244,11 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     try {
       if constexpr (kMixed) {
         for (std::size_t r = 0; r + 1 < ts.runs.size(); ++r)
-          sw.pipeline->evaluate_range(*ts.ws, sw.pairs[ts.runs[r].second], sw.dt, ts.runs[r].first,
+          sw.pipeline->evaluate_range(*ts.ws, sw.pairs[ts.runs[r].second], sw.rolling[ts.runs[r].second], sw.dt,
+                                      ts.runs[r].first,
                                       ts.runs[r + 1].first - ts.runs[r].first);
       } else {
-        sw.pipeline->evaluate(*ts.ws, sw.pairs[0], sw.dt, c);
+        sw.pipeline->evaluate(*ts.ws, sw.pairs[0], sw.rolling[0], sw.dt, c);
       }
     } catch (const PluginError& err) {
       throw_batch_failure(err, s, entry, c, li, [&](uint32_t le) { return "particle id " + std::to_string(s.id[lj[le]]); });
@@ -346,7 +346,8 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
     uint32_t c = 0;
     // this wall's pair constants, by the particle's local material
     const domel_pair_v2* wall_pairs = sw.pairs + w * sw.n_materials;
-    const bool mixed = sw.n_materials > 1;
+    const ModelInstance* const* wall_rolling = sw.rolling + w * sw.n_materials;
+    const bool mixed = sw.n_materials > 1 && !sw.uniform[w];
     double* load = nullptr;
     if (wall.track_load) {
       if (ts.wall_load.size() < 3 * sw.lists->size()) ts.wall_load.resize(3 * sw.lists->size(), 0.0);
@@ -356,11 +357,11 @@ void wall_range(const WallSweep& sw, ContactScratch& ts, std::size_t first, std:
       if (c == 0) return;
       try {
         if (!mixed) {
-          sw.pipeline->evaluate(*ts.ws, wall_pairs[0], sw.dt, c);
+          sw.pipeline->evaluate(*ts.ws, wall_pairs[0], wall_rolling[0], sw.dt, c);
         } else {
           for (std::size_t r = 0; r + 1 < ts.runs.size(); ++r)
-            sw.pipeline->evaluate_range(*ts.ws, wall_pairs[ts.runs[r].second], sw.dt, ts.runs[r].first,
-                                        ts.runs[r + 1].first - ts.runs[r].first);
+            sw.pipeline->evaluate_range(*ts.ws, wall_pairs[ts.runs[r].second], wall_rolling[ts.runs[r].second],
+                                        sw.dt, ts.runs[r].first, ts.runs[r + 1].first - ts.runs[r].first);
         }
       } catch (const PluginError& err) {
         throw_batch_failure(err, s, ts.entry.data(), c, list.particle.data(),

@@ -74,7 +74,14 @@ struct PairSweep {
   const ParticleStore* store;
   NeighborList* list;
   const ContactPipeline* pipeline;
-  const domel_pair_v2* pairs;  ///< [a * n_materials + b], by the particles' local materials
+  /// The classes of material pairs that act alike (Subdomain): their
+  /// constants and rolling models (null: none), and the class of the pair of
+  /// local materials a and b at [a * n_materials + b]. One class: every
+  /// contact takes class 0's.
+  const domel_pair_v2* pairs;
+  const ModelInstance* const* rolling;
+  const uint16_t* pair_class;
+  uint32_t n_classes;
   uint32_t n_materials;
   double dt;
   bool record;  ///< append each contact's force to ContactScratch::records
@@ -89,8 +96,8 @@ using PairRangeFn = void (*)(const PairSweep&, std::size_t first, std::size_t la
                              const ForceAccumulator& shared);
 /// The pair_range instance for a pipeline (with or without a couple, with or
 /// without the masses its stages read), with or without zones, for one
-/// material or several (`mixed`: each batch is grouped by material pair and
-/// evaluated run by run; one material keeps the single-pair path).
+/// class of material pairs or several (`mixed`: each batch is grouped by
+/// class and evaluated run by run; one class keeps the single-pair path).
 PairRangeFn pair_kernel(const ContactPipeline& pipeline, bool zoned, bool mixed, bool periodic);
 
 /// The inputs of the wall sweep of one force evaluation.
@@ -99,6 +106,8 @@ struct WallSweep {
   std::vector<WallNeighbors>* lists;
   const std::vector<WallPrimitive>* walls;   ///< placed at wall_time
   const domel_pair_v2* pairs;                ///< [w * n_materials + a], per wall and particle material
+  const ModelInstance* const* rolling;       ///< the rolling model of each pair, same order (null: none)
+  const uint8_t* uniform;                    ///< per wall: every material meets it alike (one run, no grouping)
   uint32_t n_materials;
   const ContactPipeline* pipeline;
   double dt;

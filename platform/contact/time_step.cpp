@@ -37,7 +37,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
   // spheres: I/2; sphere on a wall: I), for the rolling spring's own limit
   // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
   // (docs/physics.md §3.6).
-  auto collide = [&](const domel_pair_v2& pair, double r_i, double r_j, double m_i, double m_j, double m_eff,
+  auto collide = [&](const domel_pair_v2& pair, const ModelInstance* rolling_model, double r_i, double r_j, double m_i, double m_j, double m_eff,
                      double i_red, double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
     const double r_eff = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
@@ -54,7 +54,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
         buf.nx[0] = 0; buf.ny[0] = 0; buf.nz[0] = 1; buf.vn[0] = vel;
         buf.vtx[0] = buf.vty[0] = buf.vtz[0] = 0; buf.wx[0] = buf.wy[0] = buf.wz[0] = 0;
         std::fill(buf.history.begin(), buf.history.end(), 0.0);
-        in.pipeline->evaluate(pair, h, 1);
+        in.pipeline->evaluate(pair, rolling_model, h, 1);
         const double k = buf.kn_tangent[0];
         if (k > 0) {
           const double omega = std::sqrt(k / m_eff);
@@ -116,11 +116,11 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     for (std::size_t b = a; b < n_mat; ++b) {
       if (smallest[b] == SIZE_MAX) continue;
       if (b == a) {  // a pair of equal spheres: m* = m/2, the relative rolling mode's inertia I/2
-        collide((*in.pairs)[a * n_mat + a], ra, ra, ma, ma, 0.5 * ma, 0.5 * ia, tc, crit, rolling);
+        collide((*in.pairs)[a * n_mat + a], (*in.pair_rolling)[a * n_mat + a], ra, ra, ma, ma, 0.5 * ma, 0.5 * ia, tc, crit, rolling);
       } else {
         const double rb = s.radius[smallest[b]], mb = s.mass[smallest[b]];
         const double ib = 0.4 * mb * rb * rb;
-        collide((*in.pairs)[a * n_mat + b], ra, rb, ma, mb, ma * mb / (ma + mb), ia * ib / (ia + ib), tc, crit,
+        collide((*in.pairs)[a * n_mat + b], (*in.pair_rolling)[a * n_mat + b], ra, rb, ma, mb, ma * mb / (ma + mb), ia * ib / (ia + ib), tc, crit,
                 rolling);
       }
       keep(pair_name(a, b));
@@ -130,7 +130,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     for (std::size_t a = 0; a < n_mat; ++a) {
       if (smallest[a] == SIZE_MAX) continue;
       const double ra = s.radius[smallest[a]], ma = s.mass[smallest[a]];
-      collide((*in.wall_pairs)[w * n_mat + a], ra, 0.0, ma, 0.0, ma, 0.4 * ma * ra * ra, tc, crit, rolling);
+      collide((*in.wall_pairs)[w * n_mat + a], (*in.wall_pair_rolling)[w * n_mat + a], ra, 0.0, ma, 0.0, ma, 0.4 * ma * ra * ra, tc, crit, rolling);
       keep(std::string("contact with wall '") + (*in.walls)[w].name + "'" +
            (n_mat == 1 ? "" : " (" + (*in.materials)[a].name + ")"));
     }

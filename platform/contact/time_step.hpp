@@ -34,6 +34,8 @@ struct TimeStepInputs {
   const std::vector<domel_pair_v2>* pairs;       ///< [a * n + b]
   const std::vector<domel_pair_v2>* wall_pairs;  ///< [w * n + a]
   const std::vector<WallPrimitive>* walls;       ///< names, for the report
+  const std::vector<const ModelInstance*>* pair_rolling;       ///< each pair's rolling model, as pairs
+  const std::vector<const ModelInstance*>* wall_pair_rolling;  ///< as wall_pairs
 };
 
 /// Rayleigh time, contact time and stability limit at `impact_velocity`

@@ -17,13 +17,16 @@ struct Material {
   double poisson_ratio = 0.0;   ///< [-]
 };
 
-/// Restitution, friction and (when the scenario gives it) the rolling
-/// friction of one pair of materials.
+/// Restitution, friction, (when the scenario gives it) the rolling friction
+/// and which rolling model acts, of one pair of materials.
 struct PairCoefficients {
   double restitution = 0.0;
   double friction = 0.0;
   double rolling_friction = 0.0;  ///< mu_r of the pair; valid when has_rolling_friction
   bool has_rolling_friction = false;
+  /// The pair's rolling model: the subdomain's (-1), none (-2) or the k-th
+  /// of the models interactions name (ContactPipeline::rolling_model).
+  int rolling_model = -1;
 };
 
 /// 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j ; 1/G* = 2(2-nu_i)(1+nu_i)/E_i + (same for j).

@@ -423,15 +423,26 @@ void ModelInstance::load_state(const std::vector<unsigned char>& bytes) const {
 }
 
 void ModelInstance::insert(const domel_insert_request_v1& request, std::vector<double>& x,
-                           std::vector<double>& y, std::vector<double>& z, std::vector<double>& r) const {
+                           std::vector<double>& y, std::vector<double>& z, std::vector<double>& r,
+                           std::vector<uint32_t>* component) const {
+  constexpr uint32_t kUnset = 0xFFFFFFFFu;  // the fill a model that names no component leaves
   std::size_t capacity = 4096;
   for (int attempt = 0; attempt < 3; ++attempt) {
     x.resize(capacity); y.resize(capacity); z.resize(capacity); r.resize(capacity);
-    domel_insert_output_v1 out{sizeof(domel_insert_output_v1), capacity, attempt ? capacity : 0, x.data(), y.data(), z.data(), r.data()};
+    if (component) component->assign(capacity, kUnset);
+    domel_insert_output_v1 out{sizeof(domel_insert_output_v1), capacity, attempt ? capacity : 0, x.data(), y.data(),
+                               z.data(), r.data(), component ? component->data() : nullptr};
     char err[1024] = {0};
     const domel_status st = model_->insertion.insert(handle_, &request, &out, err, sizeof err);
     if (st == DOMEL_OK) {
       x.resize(out.count); y.resize(out.count); z.resize(out.count); r.resize(out.count);
+      if (component) {
+        component->resize(out.count);
+        if (std::find(component->begin(), component->end(), kUnset) != component->end())
+          throw PluginError(host_->prefix + ": the model did not say which component of the mixture each particle "
+                                            "is (ABI 2.4: rebuild it against this SDK and draw its sizes with "
+                                            "SizeDistribution::draw, pushing each particle with its component)");
+      }
       return;
     }
     if (st != DOMEL_ERR_CAPACITY) fail("insertion", err);

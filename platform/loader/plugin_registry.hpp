@@ -117,9 +117,11 @@ class ModelInstance {
 
   /// Run the contact kernel on a batch; a failure status throws PluginError.
   void contact(domel_contact_batch_v2& batch) const;
-  /// Run an insertion (with one capacity retry).
+  /// Run an insertion (with one capacity retry). With `component`, also
+  /// each particle's mixture component (ABI 2.4); a model that does not say
+  /// for every particle is refused (PluginError).
   void insert(const domel_insert_request_v1& request, std::vector<double>& x, std::vector<double>& y,
-              std::vector<double>& z, std::vector<double>& r) const;
+              std::vector<double>& z, std::vector<double>& r, std::vector<uint32_t>* component = nullptr) const;
   /// Run a controller on one control interval.
   void control(domel_control_step_v1& step) const;
   /// Run a fluid coupler's exchange of one coupling interval.

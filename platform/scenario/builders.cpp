@@ -46,6 +46,9 @@ struct Build {
   std::map<std::string, std::array<double, 2>> radii;
   /// fine subdomain -> (coarse subdomain, coupling index) from /couplings
   std::map<std::string, std::pair<std::string, std::size_t>> parent;
+  /// the interactions (indices) that name their own rolling model, in the
+  /// order of PairCoefficients::rolling_model
+  std::vector<std::size_t> pair_rolling;
 };
 
 void build_materials(Build& b) {
@@ -58,7 +61,8 @@ void build_materials(Build& b) {
     b.mat_index[name] = b.sim.materials.size();
     b.sim.materials.push_back(mat);
   }
-  for (const auto& it : b.doc["interactions"]) {
+  for (std::size_t q = 0; q < b.doc["interactions"].size(); ++q) {
+    const json& it = b.doc["interactions"][q];
     // std::minmax returns references: bind the names first (temporaries would dangle)
     const std::string x = it["materials"][0].get<std::string>(), y = it["materials"][1].get<std::string>();
     const std::pair<std::string, std::string> key = std::minmax(x, y);
@@ -67,6 +71,16 @@ void build_materials(Build& b) {
     c.friction = it["friction"].get<double>();
     c.has_rolling_friction = it.contains("rolling_friction");
     if (c.has_rolling_friction) c.rolling_friction = it["rolling_friction"].get<double>();
+    // its own rolling model: every subdomain's pipeline makes one instance
+    // of each, in this order (build_contact_pipeline)
+    if (it.contains("rolling")) {
+      if (it["rolling"]["model"] == "none") {
+        c.rolling_model = ContactPipeline::kNoRolling;
+      } else {
+        c.rolling_model = static_cast<int>(b.pair_rolling.size());
+        b.pair_rolling.push_back(q);
+      }
+    }
   }
 }
 
@@ -178,8 +192,36 @@ std::unique_ptr<ContactPipeline> build_contact_pipeline(Build& b, const json& sd
                            {"library", b.registry.libraries()[m->library].name},
                            {"library_version", b.registry.libraries()[m->library].version}};
   }
+  // the rolling models of the material pairs that name their own
+  std::vector<std::unique_ptr<ModelInstance>> pair_rolling;
+  for (std::size_t q : b.pair_rolling) {
+    const json& it = b.doc["interactions"][q];
+    const json& block = it["rolling"];
+    const std::string where = idx("/interactions", q) + "/rolling";
+    const std::string model = block["model"].get<std::string>();
+    const RegisteredModel* m = b.registry.find(DOMEL_KIND_ROLLING, model);
+    if (!m) {  // check_models() reported it
+      ok = false;
+      continue;
+    }
+    try {
+      pair_rolling.push_back(std::make_unique<ModelInstance>(
+          *m, plugin_params(block, DOMEL_KIND_ROLLING),
+          "subdomain '" + sd["name"].get<std::string>() + "', pair (" + it["materials"][0].get<std::string>() + ", " +
+              it["materials"][1].get<std::string>() + ")"));
+    } catch (const PluginError& e) {
+      if (&sd == &b.doc["subdomains"][0]) b.ck.add(where, e.what());  // once, not per subdomain
+      ok = false;
+      continue;
+    }
+    used["rolling (" + it["materials"][0].get<std::string>() + ", " + it["materials"][1].get<std::string>() + ")"] = {
+        {"model", model},
+        {"version", m->version},
+        {"library", b.registry.libraries()[m->library].name},
+        {"library_version", b.registry.libraries()[m->library].version}};
+  }
   if (!ok) return nullptr;
-  return std::make_unique<ContactPipeline>(std::move(slots));
+  return std::make_unique<ContactPipeline>(std::move(slots), std::move(pair_rolling));
 }
 
 /// What can be known about a subdomain's starting particles before a step:
@@ -290,8 +332,7 @@ struct Inserter {
   double velocity[3] = {0, 0, 0};
   bool fixed = false;
   std::uint64_t seed = 0;
-  std::uint8_t material = 0;  ///< the particles' material, local to the subdomain
-  double density = 0;         ///< its density [kg/m^3]
+  InsertedMaterials materials;  ///< the particles' material(s), local to the subdomain
 };
 
 /// Throws PluginError when the plugin refuses its parameters. `derived_seed`
@@ -299,12 +340,46 @@ struct Inserter {
 Inserter make_inserter(Build& b, const json& block, Subdomain& sub, std::uint64_t derived_seed) {
   Inserter ins;
   ins.registered = b.registry.find(DOMEL_KIND_INSERTION, block["model"].get<std::string>());
-  ins.model = std::make_shared<ModelInstance>(*ins.registered, plugin_params(block, DOMEL_KIND_INSERTION),
-                                              "subdomain '" + sub.name() + "'");
+  json params = plugin_params(block, DOMEL_KIND_INSERTION);
   const std::size_t global = block.contains("material") ? b.mat_index.at(block["material"].get<std::string>())
                                                         : sub.material();
-  ins.material = sub.local_material(global);  // registered by build_subdomain() already
-  ins.density = b.sim.materials[global].density;
+  auto add = [&](std::size_t g) {
+    ins.materials.material.push_back(sub.local_material(g));  // registered by build_subdomain() already
+    ins.materials.density.push_back(b.sim.materials[g].density);
+  };
+  if (insertion_mixture(block)) {
+    // A mixture: each component's material (its own, else the block's). The
+    // model samples one density, so mass fractions of materials of
+    // different densities reach it as volume fractions f_i / rho_i.
+    // A malformed mixture goes to the model as written, which names the problem.
+    json& mix = params["distribution"];
+    const json* comps = member(mix, "components");
+    bool well_formed = comps && comps->is_array() && !comps->empty();
+    double sum = 0;
+    for (std::size_t k = 0; well_formed && k < comps->size(); ++k) {
+      const json& c = (*comps)[k];
+      const json* f = member(c, "fraction");
+      const json* m = member(c, "material");
+      well_formed = f && f->is_number() && (!m || (m->is_string() && b.mat_index.count(m->get<std::string>())));
+      if (well_formed) sum += f->get<double>();
+    }
+    if (well_formed)
+      for (const json& c : *comps) add(c.contains("material") ? b.mat_index.at(c["material"].get<std::string>()) : global);
+    else
+      add(global);
+    const auto& rho = ins.materials.density;
+    if (well_formed && std::fabs(sum - 1.0) <= 1e-6 && member(mix, "by") && mix["by"] == "mass" &&
+        std::any_of(rho.begin(), rho.end(), [&](double r) { return r != rho[0]; })) {
+      double total = 0;
+      for (std::size_t k = 0; k < rho.size(); ++k) total += mix["components"][k]["fraction"].get<double>() / rho[k];
+      for (std::size_t k = 0; k < rho.size(); ++k)
+        mix["components"][k]["fraction"] = mix["components"][k]["fraction"].get<double>() / rho[k] / total;
+      mix["by"] = "volume";
+    }
+  } else {
+    add(global);
+  }
+  ins.model = std::make_shared<ModelInstance>(*ins.registered, params, "subdomain '" + sub.name() + "'");
   ins.region = make_region(block["region"]);
   for (int a = 0; a < 3; ++a) ins.velocity[a] = block["velocity"][a].get<double>();
   ins.fixed = block["fixed"].get<bool>();
@@ -333,10 +408,12 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
       const Inserter ins = make_inserter(b, block, sub, b.sim.seed * 1000003ull + hash + q);
       ParticleStore& st = sub.store();
       const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
-                                                               b.sim.flow.max_particles, sub.periodic());
+                                                      b.sim.flow.max_particles, sub.periodic(),
+                                                      ins.materials.mixture());
       st.reserve(st.size() + c.size());
       for (std::size_t p = 0; p < c.size(); ++p) {
-        st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], ins.density, ins.fixed, ins.material);
+        st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], ins.materials.density_of(c, p), ins.fixed,
+               ins.materials.material_of(c, p));
         st.vx.back() = ins.velocity[0]; st.vy.back() = ins.velocity[1]; st.vz.back() = ins.velocity[2];
       }
       spdlog::info("subdomain '{}': inserted {} particles with '{}' ({})", sub.name(), c.size(), ins.registered->name,
@@ -377,8 +454,7 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
       for (int a = 0; a < 3; ++a) p.velocity[a] = ins.velocity[a];
       p.fixed = ins.fixed;
       p.seed = ins.seed;
-      p.density = ins.density;
-      p.material = ins.material;
+      p.materials = ins.materials;
       p.alpha = sub.coarse_grain();
       p.mass_rate = pb["mass_rate"].get<double>();
       if (pb.contains("total_mass")) p.total_mass = pb["total_mass"].get<double>();
@@ -401,16 +477,28 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
           p.interval = 0.01;
         }
       }
-      const InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr, b.sim.flow.max_particles);
+      const InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr,
+                                                      b.sim.flow.max_particles, {}, p.materials.mixture());
       if (c.size() == 0) {
         b.ck.add(where + "/insert", "the insertion model placed no particle in the pour region",
                  "enlarge the region or raise the model's volume_fraction / count");
         continue;
       }
-      pour_radii.push_back({*std::min_element(c.r.begin(), c.r.end()), *std::max_element(c.r.begin(), c.r.end()),
-                            p.density, p.material});
+      // each component's size range (one for a single material)
+      std::vector<PourProbe> probes(p.materials.material.size(), PourProbe{HUGE_VAL, 0.0, 0.0, 0});
       double one_event = 0;
-      for (double rr : c.r) one_event += p.density * 4.0 / 3.0 * M_PI * rr * rr * rr;
+      for (std::size_t q = 0; q < c.size(); ++q) {
+        PourProbe& pp = probes[c.component.empty() ? 0 : c.component[q]];
+        pp.r_min = std::min(pp.r_min, c.r[q]);
+        pp.r_max = std::max(pp.r_max, c.r[q]);
+        one_event += p.materials.density_of(c, q) * 4.0 / 3.0 * M_PI * c.r[q] * c.r[q] * c.r[q];
+      }
+      for (std::size_t k = 0; k < probes.size(); ++k)
+        if (probes[k].r_max > 0) {
+          probes[k].density = p.materials.density[k];
+          probes[k].material = p.materials.material[k];
+          pour_radii.push_back(probes[k]);
+        }
       spdlog::info("subdomain '{}': pour {} inserts {:.4g} kg/s with '{}' every {:.4g} s (one full region: {} "
                    "particles, {:.4g} kg)",
                    sub.name(), where, p.mass_rate, ins.registered->name, p.interval, c.size(), one_event);
@@ -488,7 +576,7 @@ void build_subdomain(Build& b, std::size_t k) {
   auto sub = std::make_unique<Subdomain>(sd_name, alpha, b.mat_index.at(mat_name), std::move(pipeline));
   // its materials: its own, then those of its insertions and pours, in order (a mixture)
   auto add_material = [&](const json& block) {
-    if (block.contains("material")) sub->local_material(b.mat_index.at(block["material"].get<std::string>()));
+    for (const auto& [name, at] : insertion_material_names(block)) sub->local_material(b.mat_index.at(name));
   };
   if (sd.contains("insert"))
     for (const auto& block : sd["insert"]) add_material(block);

@@ -223,6 +223,11 @@ json* member_mut(json& j, const char* key) { return const_cast<json*>(member(j, 
 void check_models(Checker& ck, json& doc, const PluginRegistry& registry, const Filled& filled) {
   if (json* fluid = member_mut(doc, "fluid"))
     check_model_block(ck, registry, *fluid, "/fluid", DOMEL_KIND_FLUID_COUPLER, false, filled);
+  if (json* its = member_mut(doc, "interactions"); its && its->is_array())
+    for (std::size_t q = 0; q < its->size(); ++q)
+      if (json* rolling = member_mut((*its)[q], "rolling"))
+        check_model_block(ck, registry, *rolling, idx("/interactions", q) + "/rolling", DOMEL_KIND_ROLLING, true,
+                          filled);
   json* sds = member_mut(doc, "subdomains");
   if (!sds || !sds->is_array()) return;
   for (std::size_t k = 0; k < sds->size(); ++k) {
@@ -521,13 +526,16 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
                                   std::vector<std::string>{mat});
         // the materials of its insertions and pours (a mixture)
         auto insert_material = [&](const json& block, const std::string& pointer) {
-          const std::string m = check_material(member(block, "material"), pointer + "/material");
-          if (m.empty()) return;
-          if (!has_density[m])
-            ck.add("/materials/" + escape_pointer_token(m), "missing required property 'density'",
-                   pointer + " makes particles of this material");
-          auto& list = sd_materials.back().second;
-          if (std::find(list.begin(), list.end(), m) == list.end()) list.push_back(m);
+          for (const auto& [name, at] : insertion_material_names(block)) {
+            const json value = name;
+            const std::string m = check_material(&value, pointer + at);
+            if (m.empty()) continue;
+            if (!has_density[m])
+              ck.add("/materials/" + escape_pointer_token(m), "missing required property 'density'",
+                     pointer + " makes particles of this material");
+            auto& list = sd_materials.back().second;
+            if (std::find(list.begin(), list.end(), m) == list.end()) list.push_back(m);
+          }
         };
         if (const json* ins = member(sd, "insert"); ins && ins->is_array())
           for (std::size_t q = 0; q < ins->size(); ++q) insert_material((*ins)[q], idx(base + "/insert", q));

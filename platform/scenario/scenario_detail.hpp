@@ -83,6 +83,30 @@ inline std::vector<std::string> platform_keys(uint32_t kind) {
   return {"model"};
 }
 
+/// The mixture of an insertion block ("distribution": {"type": "mixture"}),
+/// or null.
+inline const json* insertion_mixture(const json& block) {
+  const json* d = member(block, "distribution");
+  if (!d || !d->is_object()) return nullptr;
+  const json* t = member(*d, "type");
+  return t && t->is_string() && t->get<std::string>() == "mixture" ? d : nullptr;
+}
+
+/// The material names an insertion block makes particles of, each with the
+/// JSON pointer (below the block's) of where it is named: the block's
+/// "material", and each mixture component's (a component without one takes
+/// the block's, or the subdomain's). Names that are not strings are skipped.
+inline std::vector<std::pair<std::string, std::string>> insertion_material_names(const json& block) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (const json* m = member(block, "material"); m && m->is_string()) out.emplace_back(m->get<std::string>(), "/material");
+  if (const json* mix = insertion_mixture(block))
+    if (const json* comps = member(*mix, "components"); comps && comps->is_array())
+      for (std::size_t k = 0; k < comps->size(); ++k)
+        if (const json* m = member((*comps)[k], "material"); m && m->is_string())
+          out.emplace_back(m->get<std::string>(), "/distribution/components/" + std::to_string(k) + "/material");
+  return out;
+}
+
 inline json plugin_params(const json& block, uint32_t kind) {
   json p = block;
   for (const auto& k : platform_keys(kind)) p.erase(k);

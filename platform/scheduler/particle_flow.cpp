@@ -34,7 +34,7 @@ double mass_kg(MassUnits u) {
 
 InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
                                       double alpha, const ParticleStore* present, std::size_t max_count,
-                                      const PeriodicBox& box) {
+                                      const PeriodicBox& box, bool components) {
   domel_insert_request_v1 req{};
   req.struct_size = sizeof(req);
   req.region = region;
@@ -75,7 +75,7 @@ InsertionCandidates request_insertion(const ModelInstance& model, const domel_re
   }
   req.max_count = max_count;
   InsertionCandidates c;
-  model.insert(req, c.x, c.y, c.z, c.r);
+  model.insert(req, c.x, c.y, c.z, c.r, components ? &c.component : nullptr);
   // a model of ABI 2.2 does not know max_count: the host refuses afterwards
   if (max_count != 0 && c.size() > max_count)
     throw PluginError(model.context() + ": the insertion placed " + std::to_string(c.size()) +
@@ -142,7 +142,8 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   const std::uint64_t seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
   InsertionCandidates c;
   try {
-    c = request_insertion(*p.model, p.region, seed, p.alpha, &st, max_particles, sd.periodic());
+    c = request_insertion(*p.model, p.region, seed, p.alpha, &st, max_particles, sd.periodic(),
+                          p.materials.mixture());
   } catch (const PluginError& e) {
     throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
   }
@@ -151,7 +152,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   std::size_t taken = 0;
   for (std::size_t q = 0; q < c.size() && p.inserted_mass < target; ++q) {
     const std::uint64_t id = next_id++;
-    st.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.density, p.fixed, p.material);
+    st.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.materials.density_of(c, q), p.fixed, p.materials.material_of(c, q));
     const std::size_t k = st.size() - 1;
     st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
     p.inserted_mass += st.mass[k];

@@ -34,10 +34,28 @@ namespace domel::platform {
 class ArchiveWriter;
 class ArchiveReader;
 
-/// Candidate particles an insertion model placed (parcel radii, alpha applied).
+/// Candidate particles an insertion model placed (parcel radii, alpha
+/// applied); for a mixture, each one's component (else empty).
 struct InsertionCandidates {
   std::vector<double> x, y, z, r;
+  std::vector<std::uint32_t> component;
   std::size_t size() const { return x.size(); }
+};
+
+/// The materials of an insertion's particles: one, or one per component of
+/// a mixture ("distribution": {"type": "mixture"}), local to the subdomain,
+/// with their densities.
+struct InsertedMaterials {
+  std::vector<std::uint8_t> material;
+  std::vector<double> density;  ///< [kg/m^3]
+  bool mixture() const { return material.size() > 1; }
+  /// Candidate q's material and density.
+  std::uint8_t material_of(const InsertionCandidates& c, std::size_t q) const {
+    return c.component.empty() ? material[0] : material[c.component[q]];
+  }
+  double density_of(const InsertionCandidates& c, std::size_t q) const {
+    return c.component.empty() ? density[0] : density[c.component[q]];
+  }
 };
 
 /// The one way the platform asks an insertion model for particles, for the
@@ -46,10 +64,11 @@ struct InsertionCandidates {
 /// (none when null), with `seed`, at most `max_count` of them (the
 /// scenario's run.max_particles; 0: no limit). Throws PluginError when the
 /// model fails or would place more. Along the periodic axes of `box` the
-/// new particles keep clear of the present ones' images too.
+/// new particles keep clear of the present ones' images too. With
+/// `components`, the model says each particle's mixture component.
 InsertionCandidates request_insertion(const ModelInstance& model, const domel_region_v1& region, std::uint64_t seed,
                                       double alpha, const ParticleStore* present, std::size_t max_count,
-                                      const PeriodicBox& box = {});
+                                      const PeriodicBox& box = {}, bool components = false);
 
 /// Exact mass in units of 1e-18 kg (sums in 128 bits).
 using MassUnits = __int128;
@@ -80,8 +99,7 @@ struct Pour {
   domel_region_v1 region{};
   double velocity[3] = {0, 0, 0};
   bool fixed = false;
-  double density = 0;
-  std::uint8_t material = 0;  ///< the particles' material, local to the subdomain
+  InsertedMaterials materials;  ///< the particles' material(s), local to the subdomain
   double alpha = 1;
   double mass_rate = 0;     ///< [kg/s]
   double total_mass = std::numeric_limits<double>::infinity();  ///< [kg]

@@ -48,17 +48,46 @@ void Subdomain::set_environment(const std::vector<Material>& materials, const vo
   local_materials_.clear();
   for (std::size_t g : materials_) local_materials_.push_back(materials.at(g));
   pairs_.assign(n * n, domel_pair_v2{});
+  pair_rolling_.assign(n * n, nullptr);
   for (std::size_t a = 0; a < n; ++a)
-    for (std::size_t b = 0; b < n; ++b)
-      pairs_[a * n + b] = make_pair(local_materials_[a], local_materials_[b],
-                                    coefficients(table, materials_[a], materials_[b]), false, coarse_grain_);
+    for (std::size_t b = 0; b < n; ++b) {
+      const PairCoefficients c = coefficients(table, materials_[a], materials_[b]);
+      pairs_[a * n + b] = make_pair(local_materials_[a], local_materials_[b], c, false, coarse_grain_);
+      pair_rolling_[a * n + b] = pipeline_->rolling_model(c.rolling_model);
+    }
   wall_pairs_.assign(walls->size() * n, domel_pair_v2{});
+  wall_pair_rolling_.assign(walls->size() * n, nullptr);
   for (std::size_t w = 0; w < walls->size(); ++w) {
     const std::size_t wm = (*walls)[w].material;
-    for (std::size_t a = 0; a < n; ++a)
-      wall_pairs_[w * n + a] = make_pair(local_materials_[a], materials.at(wm), coefficients(table, materials_[a], wm),
-                                         true, coarse_grain_);
+    for (std::size_t a = 0; a < n; ++a) {
+      const PairCoefficients c = coefficients(table, materials_[a], wm);
+      wall_pairs_[w * n + a] = make_pair(local_materials_[a], materials.at(wm), c, true, coarse_grain_);
+      wall_pair_rolling_[w * n + a] = pipeline_->rolling_model(c.rolling_model);
+    }
   }
+  // classes of pairs that act alike
+  auto same = [](const domel_pair_v2& p, const ModelInstance* pr, const domel_pair_v2& q, const ModelInstance* qr) {
+    return pr == qr && p.is_wall == q.is_wall && p.youngs_eff == q.youngs_eff && p.shear_eff == q.shear_eff &&
+           p.restitution == q.restitution && p.friction == q.friction && p.coarse_grain == q.coarse_grain &&
+           p.has_rolling_friction == q.has_rolling_friction && p.rolling_friction == q.rolling_friction;
+  };
+  pair_class_.assign(n * n, 0);
+  class_pairs_.clear();
+  class_rolling_.clear();
+  for (std::size_t k = 0; k < n * n; ++k) {
+    std::size_t c = 0;
+    while (c < class_pairs_.size() && !same(class_pairs_[c], class_rolling_[c], pairs_[k], pair_rolling_[k])) ++c;
+    if (c == class_pairs_.size()) {
+      class_pairs_.push_back(pairs_[k]);
+      class_rolling_.push_back(pair_rolling_[k]);
+    }
+    pair_class_[k] = static_cast<uint16_t>(c);  // at most n (n + 1) / 2 classes, n <= 256 (uint8 materials)
+  }
+  wall_uniform_.assign(walls->size(), 1);
+  for (std::size_t w = 0; w < walls->size(); ++w)
+    for (std::size_t a = 1; a < n; ++a)
+      if (!same(wall_pairs_[w * n], wall_pair_rolling_[w * n], wall_pairs_[w * n + a], wall_pair_rolling_[w * n + a]))
+        wall_uniform_[w] = 0;
   wall_lists_.assign(walls->size(), WallNeighbors{});
   walls_now_ = *walls;
   for (int a = 0; a < 3; ++a) body_forces_.gravity[a] = gravity[a];
@@ -66,7 +95,8 @@ void Subdomain::set_environment(const std::vector<Material>& materials, const vo
 
 TimeStepReport Subdomain::estimate_time_step(double impact_velocity) {
   synchronize();
-  return platform::estimate_time_step({pipeline_.get(), &local_materials_, &pairs_, &wall_pairs_, &walls_now_}, store_,
+  return platform::estimate_time_step({pipeline_.get(), &local_materials_, &pairs_, &wall_pairs_, &walls_now_,
+                                       &pair_rolling_, &wall_pair_rolling_}, store_,
                                       impact_velocity);
 }
 
@@ -408,12 +438,14 @@ void Subdomain::step_in_order() {
 }
 
 PairSweep Subdomain::pair_sweep() const {
-  return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), pairs_.data(),
-          static_cast<uint32_t>(materials_.size()), dt_, record_};
+  return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), class_pairs_.data(), class_rolling_.data(),
+          pair_class_.data(), static_cast<uint32_t>(class_pairs_.size()), static_cast<uint32_t>(materials_.size()),
+          dt_, record_};
 }
 
 WallSweep Subdomain::wall_sweep() {
-  return {&store_, &wall_lists_, &walls_now_, wall_pairs_.data(), static_cast<uint32_t>(materials_.size()),
+  return {&store_, &wall_lists_, &walls_now_, wall_pairs_.data(), wall_pair_rolling_.data(), wall_uniform_.data(),
+          static_cast<uint32_t>(materials_.size()),
           pipeline_.get(), dt_, forces_time_, wall_time_, record_};
 }
 
@@ -446,7 +478,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
     ts.pair_max_ratio = 0.0;
   }
   if (nt == 1) {
-    const PairRangeFn range = pair_kernel(*pipeline_, false, materials_.size() > 1, nlist_.periodic().any());
+    const PairRangeFn range = pair_kernel(*pipeline_, false, class_pairs_.size() > 1, nlist_.periodic().any());
     range(sweep, 0, nlist_.near_size(), scratch_[0], 0, s.size(), direct, direct);
     if (far) range(sweep, nlist_.near_size(), nlist_.size(), scratch_[0], 0, s.size(), direct, direct);
   } else {
@@ -463,7 +495,7 @@ void Subdomain::pair_forces(bool defer_reduce) {
       const ForceAccumulator shared = t > 0 ? partition_.private_accumulator(t, n) : direct;
       const ForcePartition::ThreadForces& tf = partition_.thread(t);
       // thread 0 adds all its forces into the store
-      const PairRangeFn range = pair_kernel(*pipeline_, t > 0, materials_.size() > 1, nlist_.periodic().any());
+      const PairRangeFn range = pair_kernel(*pipeline_, t > 0, class_pairs_.size() > 1, nlist_.periodic().any());
       const auto [near_first, near_last] = partition_.entries(0, t);
       range(sweep, near_first, near_last, ts, tf.own_lo, tf.own_hi, direct, shared);
       if (far) {

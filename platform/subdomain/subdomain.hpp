@@ -100,6 +100,16 @@ class Subdomain {
   /// of a particle of local material a with wall primitive w.
   const domel_pair_v2& pair(std::size_t a, std::size_t b) const { return pairs_[a * materials_.size() + b]; }
   const domel_pair_v2& wall_pair(std::size_t w, std::size_t a) const { return wall_pairs_[w * materials_.size() + a]; }
+  /// Classes of material pairs that act alike (the same constants and
+  /// rolling model): the contact sweep evaluates each as one run.
+  std::size_t pair_classes() const { return class_pairs_.size(); }
+  /// The rolling model acting on those pairs (null: none).
+  const ModelInstance* pair_rolling(std::size_t a, std::size_t b) const {
+    return pair_rolling_[a * materials_.size() + b];
+  }
+  const ModelInstance* wall_pair_rolling(std::size_t w, std::size_t a) const {
+    return wall_pair_rolling_[w * materials_.size() + a];
+  }
 
   /// Gravity that changes with time (core/gravity.hpp): read once per step
   /// for the forces at the step's end. Without one, gravity stays the
@@ -223,6 +233,15 @@ class Subdomain {
   std::vector<Material> local_materials_;  ///< their constants, same order
   std::vector<domel_pair_v2> pairs_;       ///< [a * n + b], n = materials_.size()
   std::vector<domel_pair_v2> wall_pairs_;  ///< [w * n + a]
+  std::vector<const ModelInstance*> pair_rolling_, wall_pair_rolling_;  ///< their rolling models, same order
+  /// Pairs of materials that act alike (the same constants and rolling
+  /// model) form one class, which the contact sweep evaluates as one run:
+  /// a mixture of materials with the same constants costs what one material
+  /// does. pair_class_[a * n + b] indexes class_pairs_ and class_rolling_.
+  std::vector<uint16_t> pair_class_;
+  std::vector<domel_pair_v2> class_pairs_;
+  std::vector<const ModelInstance*> class_rolling_;
+  std::vector<uint8_t> wall_uniform_;  ///< per wall primitive: every material meets it alike
   BodyForces body_forces_;
   std::shared_ptr<const GravitySchedule> gravity_;  ///< null: constant gravity
   StepHooks hooks_;

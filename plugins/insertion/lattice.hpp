@@ -39,7 +39,7 @@ class Lattice {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_INSERTION;
   static constexpr const char* kName = "lattice";
-  static constexpr const char* kVersion = "1.2.0";
+  static constexpr const char* kVersion = "1.3.0";
   static constexpr const char* kSummary =
       "equal spheres on a simple cubic lattice filling the region, optionally jittered";
   static constexpr const char* kSchema = R"json({
@@ -57,7 +57,7 @@ class Lattice {
                "description": "stop after this many particles (default: fill every site)" },
     "arrangement": { "enum": ["simple_cubic"], "default": "simple_cubic",
                      "description": "lattice type" },
-    "distribution": { "type": "object", "description": "particle diameters drawn from a distribution by number, in place of diameter; the lattice is spaced for the largest (multiplied by alpha): {\"type\": \"uniform\", \"min\", \"max\"}, {\"type\": \"normal\", \"mean\", \"std\", \"min\", \"max\"} (truncated, default mean +- 3 std), {\"type\": \"lognormal\", \"median\", \"sigma\" (of ln d), \"min\", \"max\"} (truncated, default median e^(+-3 sigma)) or {\"type\": \"table\", \"diameters\": [...], \"fractions\": [...], \"by\": \"number\" or \"mass\"}; docs/getting-started.md, \"Size distributions\"" },
+    "distribution": { "type": "object", "description": "particle diameters drawn from a distribution by number, in place of diameter; the lattice is spaced for the largest (multiplied by alpha): {\"type\": \"uniform\", \"min\", \"max\"}, {\"type\": \"normal\", \"mean\", \"std\", \"min\", \"max\"} (truncated, default mean +- 3 std), {\"type\": \"lognormal\", \"median\", \"sigma\" (of ln d), \"min\", \"max\"} (truncated, default median e^(+-3 sigma)) or {\"type\": \"table\", \"diameters\": [...], \"fractions\": [...], \"by\": \"number\" or \"mass\"}, or a mixture of materials {\"type\": \"mixture\", \"by\": \"mass\" | \"volume\" | \"number\", \"components\": [{\"material\", \"fraction\", \"diameter\" or \"distribution\"}, ...]}; docs/getting-started.md, \"Size distributions\" and \"Mixtures\"" },
     "origin": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m",
                 "description": "anchor the lattice: sites at origin + (i + 0.5) a for integer i (default: the region's lower corner), e.g. to reproduce another code's lattice" }
   },
@@ -163,7 +163,14 @@ class Lattice {
             if (!sphere_inside(g, x, y, z, r)) { x = sx; y = sy; z = sz; }
           }
           if (existing && existing->overlaps(x, y, z, r)) continue;
-          out.push(x, y, z, distribution_ ? 0.5 * alpha * distribution_->sample(sizes) : r);
+          if (!distribution_) {
+            out.push(x, y, z, r);
+          } else if (distribution_->type() != sdk::SizeDistribution::Type::mixture) {
+            out.push(x, y, z, 0.5 * alpha * distribution_->sample(sizes));
+          } else {  // each site draws its component and diameter: the components interleave
+            const auto dr = distribution_->draw(sizes);
+            out.push(x, y, z, 0.5 * alpha * dr.diameter, dr.component);
+          }
           if (count_ != 0 && out.size() >= count_) return;
         }
     if (!any_site) {

@@ -4,5 +4,5 @@
 #include "lattice.hpp"
 #include "random_fill.hpp"
 
-DOMEL_PLUGIN_LIBRARY("domel_insertion_std", "1.2.0", domel::plugins::insertion::Lattice,
+DOMEL_PLUGIN_LIBRARY("domel_insertion_std", "1.3.0", domel::plugins::insertion::Lattice,
                      domel::plugins::insertion::RandomFill)

@@ -22,7 +22,9 @@
 // large sphere more often than a small one and would otherwise jam before
 // the large ones are in; the placed spheres are then handed over in random
 // order, so that any first part of them (a pour keeps the first ones until
-// its mass is reached) has the requested composition.
+// its mass is reached) has the requested composition. A mixture's
+// particles (several materials) are drawn and placed together, each keeping
+// its component for the host.
 // Deterministic: std::mt19937_64 seeded with the request's seed.
 // Units: diameters in m; volume_fraction dimensionless.
 #pragma once
@@ -47,7 +49,7 @@ class RandomFill {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_INSERTION;
   static constexpr const char* kName = "random";
-  static constexpr const char* kVersion = "1.1.0";
+  static constexpr const char* kVersion = "1.2.0";
   static constexpr const char* kSummary =
       "non-overlapping spheres at random positions (sequential simple inhibition / RSA)";
   static constexpr const char* kSchema = R"json({
@@ -59,7 +61,7 @@ class RandomFill {
                   "description": "particle diameter, or the smallest diameter when diameter_max is given (multiplied by the subdomain's coarse-grain ratio alpha)" },
     "diameter_max": { "type": "number", "exclusiveMinimum": 0, "x-unit": "m",
                       "description": "largest diameter: diameters are then uniform in [diameter, diameter_max]; must not be below diameter" },
-    "distribution": { "type": "object", "description": "particle diameters drawn from a distribution by number, in place of diameter (multiplied by alpha): {\"type\": \"uniform\", \"min\", \"max\"}, {\"type\": \"normal\", \"mean\", \"std\", \"min\", \"max\"} (truncated, default mean +- 3 std), {\"type\": \"lognormal\", \"median\", \"sigma\" (of ln d), \"min\", \"max\"} (truncated, default median e^(+-3 sigma)) or {\"type\": \"table\", \"diameters\": [...], \"fractions\": [...], \"by\": \"number\" or \"mass\"}; docs/getting-started.md, \"Size distributions\"" },
+    "distribution": { "type": "object", "description": "particle diameters drawn from a distribution by number, in place of diameter (multiplied by alpha): {\"type\": \"uniform\", \"min\", \"max\"}, {\"type\": \"normal\", \"mean\", \"std\", \"min\", \"max\"} (truncated, default mean +- 3 std), {\"type\": \"lognormal\", \"median\", \"sigma\" (of ln d), \"min\", \"max\"} (truncated, default median e^(+-3 sigma)) or {\"type\": \"table\", \"diameters\": [...], \"fractions\": [...], \"by\": \"number\" or \"mass\"}, or a mixture of materials {\"type\": \"mixture\", \"by\": \"mass\" | \"volume\" | \"number\", \"components\": [{\"material\", \"fraction\", \"diameter\" or \"distribution\"}, ...]}; docs/getting-started.md, \"Size distributions\" and \"Mixtures\"" },
     "count": { "type": "integer", "minimum": 1, "maximum": 100000000,
                "description": "number of particles to insert" },
     "volume_fraction": { "type": "number", "exclusiveMinimum": 0, "maximum": 0.38, "x-unit": "1",
@@ -130,18 +132,24 @@ class RandomFill {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     // a distribution: every diameter first, placed largest first into a
     // buffer that is handed over shuffled (see the file's comment)
-    std::vector<double> drawn;
+    // (a mixture's particles carry their component along)
+    std::vector<sdk::SizeDistribution::Draw> drawn;
+    std::vector<std::uint32_t> placed_component;
     sdk::Inserted placed_sorted;
     sdk::Inserted& dest = has_distribution_ ? placed_sorted : out;
+    const bool mixture = has_distribution_ && distribution_.type() == sdk::SizeDistribution::Type::mixture;
     if (has_distribution_) {
       drawn.resize(target);
-      for (double& d : drawn) d = alpha * distribution_.sample(rng);
-      std::sort(drawn.begin(), drawn.end(), [](double a, double b) { return a > b; });
+      for (auto& d : drawn) {
+        d = distribution_.draw(rng);
+        d.diameter *= alpha;
+      }
+      std::sort(drawn.begin(), drawn.end(), [](const auto& a, const auto& b) { return a.diameter > b.diameter; });
     }
     dest.x.reserve(target); dest.y.reserve(target); dest.z.reserve(target); dest.r.reserve(target);
     double solid = 0.0;  // volume of the spheres placed so far
     for (std::size_t n = 0; n < target; ++n) {
-      const double d = has_distribution_ ? drawn[n] : d_hi > d_lo ? d_lo + (d_hi - d_lo) * unit(rng) : d_lo;
+      const double d = has_distribution_ ? drawn[n].diameter : d_hi > d_lo ? d_lo + (d_hi - d_lo) * unit(rng) : d_lo;
       const double r = 0.5 * d;
       check_fits(g, r);
       bool placed = false;
@@ -151,6 +159,7 @@ class RandomFill {
         if (grid.overlaps(p[0], p[1], p[2], r)) continue;
         grid.add(p[0], p[1], p[2], r);
         dest.push(p[0], p[1], p[2], r);
+        if (mixture) placed_component.push_back(drawn[n].component);
         solid += kPi / 6.0 * d * d * d;
         placed = true;
       }
@@ -167,7 +176,11 @@ class RandomFill {
       std::vector<std::size_t> order(placed_sorted.size());
       for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
       std::shuffle(order.begin(), order.end(), rng);
-      for (std::size_t k : order) out.push(placed_sorted.x[k], placed_sorted.y[k], placed_sorted.z[k], placed_sorted.r[k]);
+      for (std::size_t k : order)
+        if (mixture)
+          out.push(placed_sorted.x[k], placed_sorted.y[k], placed_sorted.z[k], placed_sorted.r[k], placed_component[k]);
+        else
+          out.push(placed_sorted.x[k], placed_sorted.y[k], placed_sorted.z[k], placed_sorted.r[k]);
     }
   }
 

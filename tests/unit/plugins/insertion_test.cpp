@@ -567,3 +567,68 @@ TEST(InsertionDistribution, ALatticeOfLogNormalDiametersPassesAKolmogorovSmirnov
                 .find("either 'distribution' or 'diameter'"),
             std::string::npos);
 }
+
+// Guards mixtures in the insertion models (issue 18 item 2): every particle
+// carries its component, and its diameter is that component's (here two
+// sizes, 1 and 2 mm, so the radius tells); random fills them together
+// (largest first, handed over shuffled: the first half holds the same
+// volume shares within 2 %); a lattice draws a component per site, so both
+// components fill the bottom and the top half alike (number shares 0.5
+// each: binomial standard deviation sqrt(0.25/n), about 0.004 for the
+// 18 000 sites of each half; 5 sigma); the ABI hands the components over when the host asks,
+// and leaves the host's fill when the model draws no mixture.
+TEST(InsertionDistribution, AMixturesParticlesCarryTheirComponentThroughEveryModelAndTheAbi) {
+  const json mix = {{"type", "mixture"},
+                    {"by", "volume"},
+                    {"components", {{{"material", "a"}, {"diameter", 1e-3}, {"fraction", 0.4}},
+                                    {{"material", "b"}, {"diameter", 2e-3}, {"fraction", 0.6}}}}};
+  const auto req = box_request(0, 0, 0, 0.05, 0.05, 0.05, 4);
+  const Inserted out = run<RandomFill>({{"model", "random"}, {"count", 10000}, {"distribution", mix}}, req);
+  ASSERT_EQ(out.component.size(), out.size());
+  auto share0 = [&](const Inserted& p, std::size_t first, std::size_t last) {
+    double v[2] = {0, 0};
+    for (std::size_t k = first; k < last; ++k) {
+      EXPECT_EQ(p.r[k], p.component[k] == 0 ? 0.5e-3 : 1e-3);
+      v[p.component[k]] += std::pow(p.r[k], 3);
+    }
+    return v[0] / (v[0] + v[1]);
+  };
+  EXPECT_NEAR(share0(out, 0, out.size()), 0.4, 0.02);
+  EXPECT_NEAR(share0(out, 0, out.size() / 2), 0.4, 0.02);
+  EXPECT_EQ(overlapping_pairs(out), 0u);
+
+  const json by_number = {{"type", "mixture"},
+                          {"by", "number"},
+                          {"components", {{{"diameter", 1e-3}, {"fraction", 0.5}}, {{"diameter", 1.5e-3}, {"fraction", 0.5}}}}};
+  const Inserted lat = run<Lattice>({{"model", "lattice"}, {"distribution", by_number}}, req);
+  ASSERT_EQ(lat.component.size(), lat.size());
+  std::size_t n[2] = {0, 0}, ones[2] = {0, 0};
+  for (std::size_t k = 0; k < lat.size(); ++k) {
+    const int half = lat.z[k] < 0.025 ? 0 : 1;
+    ++n[half];
+    ones[half] += lat.component[k];
+    EXPECT_EQ(lat.r[k], lat.component[k] == 0 ? 0.5e-3 : 0.75e-3);
+  }
+  for (int h = 0; h < 2; ++h) EXPECT_NEAR(static_cast<double>(ones[h]) / n[h], 0.5, 5 * std::sqrt(0.25 / n[h]));
+
+  // through the ABI: the host's array gets the components; without a mixture it keeps its fill
+  using Export = domel::sdk::detail::Export<Lattice>;
+  char err[256] = {0};
+  for (const bool mixture : {true, false}) {
+    void* inst = nullptr;
+    const json p = mixture ? json{{"distribution", by_number}} : json{{"diameter", 1e-3}};
+    ASSERT_EQ(Export::create(p.dump().c_str(), nullptr, &inst, err, sizeof err), DOMEL_OK) << err;
+    const std::size_t cap = 200000;
+    std::vector<double> x(cap), y(cap), z(cap), r(cap);
+    std::vector<uint32_t> c(cap, 0xFFFFFFFFu);
+    domel_insert_output_v1 o{sizeof o, cap, 0, x.data(), y.data(), z.data(), r.data(), c.data()};
+    ASSERT_EQ(Export::insert(inst, &req, &o, err, sizeof err), DOMEL_OK) << err;
+    if (mixture) {
+      ASSERT_EQ(o.count, lat.size());
+      EXPECT_TRUE(std::equal(lat.component.begin(), lat.component.end(), c.begin()));
+    } else {
+      EXPECT_EQ(c[0], 0xFFFFFFFFu);
+    }
+    Export::destroy(inst);
+  }
+}

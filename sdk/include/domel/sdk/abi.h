@@ -41,7 +41,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 2
-#define DOMEL_ABI_MINOR 3
+#define DOMEL_ABI_MINOR 4
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -235,6 +235,12 @@ typedef struct domel_insert_output_v1 {
   size_t capacity;            /**< room in x, y, z, r */
   size_t count;               /**< written; on DOMEL_ERR_CAPACITY: the count needed */
   double *x, *y, *z, *r;
+  /* ABI 2.4 */
+  uint32_t *component;        /**< NULL, or room for `capacity` entries: the host asks which component of a
+                                   mixture ("distribution": {"type": "mixture", ...}) each particle is drawn
+                                   from (its index in "components"); a model that cannot say leaves the
+                                   host's fill (UINT32_MAX) and the host refuses the mixture.
+                                   domel::sdk::SizeDistribution::draw and Inserted::push do it */
 } domel_insert_output_v1;
 
 typedef domel_status (*domel_insert_fn)(void* instance, const domel_insert_request_v1* request,

@@ -121,7 +121,6 @@ class Params {
   Host host_;
 };
 
-/// Particles produced by an insertion model (radii already include alpha).
 /// A model's state for a checkpoint (abi.h, domel_state_sink_v1): values
 /// and arrays of trivially copyable types, in the order the model chooses.
 /// Host and plugin run on one machine, so the bytes are native.
@@ -191,8 +190,13 @@ class StateReader {
   std::size_t at_ = 0;
 };
 
+/// Particles produced by an insertion model (radii already include alpha).
+/// A model that draws its sizes from a mixture (SizeDistribution::draw)
+/// pushes each particle with its component; the host reads them (ABI 2.4)
+/// only when every particle has one.
 struct Inserted {
   std::vector<double> x, y, z, r;
+  std::vector<std::uint32_t> component;  ///< per particle when pushed with one, else empty
   /// The most particles the host accepts (the request's max_count; 0: no
   /// limit): push() beyond it, or expect() of more, throws.
   std::size_t limit = 0;
@@ -200,6 +204,13 @@ struct Inserted {
     if (limit != 0 && r.size() >= limit) too_many("more than " + std::to_string(limit));
     x.push_back(px); y.push_back(py); z.push_back(pz); r.push_back(pr);
   }
+  /// The same, for a particle of component `c` of a mixture.
+  void push(double px, double py, double pz, double pr, std::uint32_t c) {
+    push(px, py, pz, pr);
+    component.resize(r.size() - 1, kNoComponent);
+    component.push_back(c);
+  }
+  static constexpr std::uint32_t kNoComponent = 0xFFFFFFFFu;
   /// Call before allocating for `n` particles: throws when n exceeds the limit.
   void expect(double n) const {
     if (limit != 0 && n > static_cast<double>(limit)) too_many("about " + std::to_string(static_cast<unsigned long long>(std::min(n, 1e19))));
@@ -374,6 +385,10 @@ struct Export {
           out->x[k] = inst->last.x[k]; out->y[k] = inst->last.y[k];
           out->z[k] = inst->last.z[k]; out->r[k] = inst->last.r[k];
         }
+        // ABI 2.4: the mixture components, when the host asks and every particle has one
+        if (out->struct_size >= offsetof(domel_insert_output_v1, component) + sizeof(out->component) &&
+            out->component != nullptr && inst->last.component.size() == n)
+          for (std::size_t k = 0; k < n; ++k) out->component[k] = inst->last.component[k];
         inst->last = Inserted{};
         return DOMEL_OK;
       });

@@ -15,6 +15,17 @@
 //        discrete sizes; fractions sum to 1 (to 1e-6); by mass, the number
 //        fraction of size i is (f_i / d_i^3) / sum_j (f_j / d_j^3) for one
 //        density
+//   {"type": "mixture", "by": "number" | "volume" | "mass",
+//    "components": [{"fraction": f, "diameter": d | "distribution": {...}, "material": name}, ...]}
+//        several components, each a diameter or one of the distributions
+//        above (not a mixture); fractions sum to 1 (to 1e-6) and measure
+//        what "by" says: the number share of component i is f_i for
+//        "number", (f_i / E_i[d^3]) / sum_j (f_j / E_j[d^3]) for "volume"
+//        and for "mass" (one density: the host turns mass fractions of
+//        materials of different densities into volume fractions before the
+//        model sees them). "material" is the host's (which material each
+//        component's particles are); a model ignores it. draw() returns the
+//        component with the diameter, for Inserted::push.
 //
 // Truncated continuous distributions are sampled by rejection from the
 // untruncated one (the truncation keeps at least 1 % of it, or the
@@ -27,6 +38,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <sstream>
 #include <string>
@@ -36,7 +48,14 @@ namespace domel::sdk {
 
 class SizeDistribution {
  public:
-  enum class Type { uniform, normal, lognormal, table };
+  enum class Type { uniform, normal, lognormal, table, mixture };
+
+  /// One draw: a diameter and the mixture component it belongs to (0
+  /// without a mixture).
+  struct Draw {
+    double diameter;
+    std::uint32_t component;
+  };
 
   /// A single diameter.
   static SizeDistribution constant(double d) {
@@ -68,9 +87,11 @@ class SizeDistribution {
       return v;
     };
     const auto t = j.find("type");
-    if (t == j.end() || !t->is_string()) fail("expected 'type': \"uniform\", \"normal\", \"lognormal\" or \"table\"");
+    if (t == j.end() || !t->is_string())
+      fail("expected 'type': \"uniform\", \"normal\", \"lognormal\", \"table\" or \"mixture\"");
     const std::string type = t->get<std::string>();
     SizeDistribution s;
+    if (type == "mixture") return parse_mixture(j, where);
     if (type == "uniform") {
       s.type_ = Type::uniform;
       s.lo_ = positive("min");
@@ -125,7 +146,7 @@ class SizeDistribution {
       s.lo_ = *std::min_element(s.sizes_.begin(), s.sizes_.end());
       s.hi_ = *std::max_element(s.sizes_.begin(), s.sizes_.end());
     } else {
-      fail("unknown 'type' \"" + type + "\" (expected \"uniform\", \"normal\", \"lognormal\" or \"table\")");
+      fail("unknown 'type' \"" + type + "\" (expected \"uniform\", \"normal\", \"lognormal\", \"table\" or \"mixture\")");
     }
     if (s.hi_ < s.lo_) {
       std::ostringstream m;
@@ -144,12 +165,34 @@ class SizeDistribution {
   Type type() const { return type_; }
   double min() const { return lo_; }
   double max() const { return hi_; }
+  /// Components of a mixture (1 otherwise).
+  std::size_t components() const { return type_ == Type::mixture ? parts_.size() : 1; }
+  /// Component k of a mixture (the distribution itself otherwise).
+  const SizeDistribution& component(std::size_t k) const { return type_ == Type::mixture ? parts_.at(k) : *this; }
+  /// The number share of component k.
+  double number_share(std::size_t k) const { return type_ == Type::mixture ? weights_.at(k) : 1.0; }
+
+  /// One diameter and its component (by number). Without a mixture it draws
+  /// exactly what sample() does.
+  template <class Rng>
+  Draw draw(Rng& rng) const {
+    if (type_ != Type::mixture) return {sample(rng), 0u};
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    double u = unit(rng);
+    std::size_t k = 0;
+    for (; k + 1 < parts_.size(); ++k) {
+      if (u < weights_[k]) break;
+      u -= weights_[k];
+    }
+    return {parts_[k].sample(rng), static_cast<std::uint32_t>(k)};
+  }
 
   /// One diameter (by number).
   template <class Rng>
   double sample(Rng& rng) const {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     switch (type_) {
+      case Type::mixture: return draw(rng).diameter;
       case Type::uniform: return hi_ > lo_ ? lo_ + (hi_ - lo_) * unit(rng) : lo_;
       case Type::normal:
       case Type::lognormal: {
@@ -177,6 +220,11 @@ class SizeDistribution {
   /// truncated normal and log-normal.
   double mean_cube() const {
     switch (type_) {
+      case Type::mixture: {
+        double m = 0;
+        for (std::size_t k = 0; k < parts_.size(); ++k) m += weights_[k] * parts_[k].mean_cube();
+        return m;
+      }
       case Type::uniform:
         return hi_ > lo_ ? (std::pow(hi_, 4) - std::pow(lo_, 4)) / (4.0 * (hi_ - lo_)) : lo_ * lo_ * lo_;
       case Type::table: {
@@ -214,10 +262,86 @@ class SizeDistribution {
   }
 
  private:
+  static SizeDistribution parse_mixture(const nlohmann::json& j, const std::string& where) {
+    auto fail = [&](const std::string& what) { throw ParameterError(where + ": " + what); };
+    for (const auto& [key, v] : j.items()) {
+      (void)v;
+      if (key != "type" && key != "by" && key != "components")
+        fail("unknown key '" + key + "' in a mixture (expected 'by' and 'components')");
+    }
+    const auto by_it = j.find("by");
+    if (by_it == j.end() || !by_it->is_string())
+      fail("expected 'by': \"mass\", \"volume\" or \"number\" (what the components' fractions measure)");
+    const std::string by = by_it->get<std::string>();
+    if (by != "number" && by != "volume" && by != "mass")
+      fail("expected 'by': \"mass\", \"volume\" or \"number\", found \"" + by + "\"");
+    const auto c = j.find("components");
+    if (c == j.end() || !c->is_array() || c->empty()) fail("expected 'components': a non-empty array");
+    SizeDistribution s;
+    s.type_ = Type::mixture;
+    double sum = 0;
+    for (std::size_t k = 0; k < c->size(); ++k) {
+      const nlohmann::json& e = (*c)[k];
+      const std::string at = where + ": 'components/" + std::to_string(k) + "'";
+      if (!e.is_object()) throw ParameterError(at + ": expected an object");
+      for (const auto& [key, v] : e.items()) {
+        (void)v;
+        if (key != "fraction" && key != "diameter" && key != "distribution" && key != "material")
+          throw ParameterError(at + ": unknown key '" + key +
+                               "' (expected 'fraction', 'diameter' or 'distribution', and 'material')");
+      }
+      const auto f = e.find("fraction");
+      if (f == e.end() || !f->is_number() || !(f->get<double>() >= 0) || !std::isfinite(f->get<double>())) {
+        std::ostringstream m;
+        m << at << ": expected 'fraction' >= 0, found " << (f == e.end() ? std::string("nothing") : f->dump());
+        throw ParameterError(m.str());
+      }
+      const bool has_d = e.contains("diameter"), has_dist = e.contains("distribution");
+      if (has_d == has_dist) throw ParameterError(at + ": expected exactly one of 'diameter' or 'distribution'");
+      SizeDistribution part;
+      if (has_d) {
+        const auto& d = e["diameter"];
+        if (!d.is_number() || !(d.get<double>() > 0) || !std::isfinite(d.get<double>())) {
+          std::ostringstream m;
+          m << at << ": expected 'diameter' > 0, found " << d.dump();
+          throw ParameterError(m.str());
+        }
+        part = constant(d.get<double>());
+      } else {
+        const auto& d = e["distribution"];
+        if (d.is_object() && d.value("type", std::string()) == "mixture")
+          throw ParameterError(at + ": a component cannot itself be a mixture");
+        part = parse(d, at + ": 'distribution'");
+      }
+      sum += f->get<double>();
+      s.weights_.push_back(f->get<double>());
+      s.parts_.push_back(std::move(part));
+    }
+    if (std::fabs(sum - 1.0) > 1e-6) {
+      std::ostringstream m;
+      m.precision(10);
+      m << "expected the components' 'fraction's summing to 1, found " << sum;
+      fail(m.str());
+    }
+    if (by != "number")  // number shares from volume (or one-density mass) fractions
+      for (std::size_t k = 0; k < s.parts_.size(); ++k) s.weights_[k] /= s.parts_[k].mean_cube();
+    double total = 0;
+    for (double w : s.weights_) total += w;
+    for (double& w : s.weights_) w /= total;
+    s.lo_ = s.parts_[0].min();
+    s.hi_ = s.parts_[0].max();
+    for (const auto& p : s.parts_) {
+      s.lo_ = std::min(s.lo_, p.min());
+      s.hi_ = std::max(s.hi_, p.max());
+    }
+    return s;
+  }
+
   Type type_ = Type::uniform;
   double lo_ = 0, hi_ = 0;
   double a_ = 0, b_ = 0;  ///< normal: mean, std; lognormal: median, sigma of ln d
-  std::vector<double> sizes_, weights_;  ///< table: diameters and number fractions
+  std::vector<double> sizes_, weights_;  ///< table: diameters and number fractions; mixture: number shares
+  std::vector<SizeDistribution> parts_;  ///< mixture: the components
 };
 
 }  // namespace domel::sdk
