@@ -10,7 +10,9 @@
 #    installed domel, and checks summary.json: rolling model "epsd" from the
 #    library "third_party_rolling", and a settled pile (final kinetic energy
 #    below 1 % of the run's peak in probes.csv); the same for a copy with the
-#    options that make it LIGGGHTS epsd2 (Iwashita-Oda stiffness, no dashpot);
+#    options that make it LIGGGHTS epsd2 (Iwashita-Oda stiffness, no dashpot),
+#    and for a copy in which the material pair names epsd
+#    (interactions[].rolling) and the subdomain has no rolling model;
 # 4. `domel validate` on a copy with a misspelt epsd parameter: exit code 2
 #    and a did-you-mean naming the right key; the same for a misspelt
 #    stiffness value, and `domel run` on viscous damping without a dashpot:
@@ -46,8 +48,15 @@ doc = json.load(open(sys.argv[1]))
 for sd in doc["subdomains"]:
     sd["contact"]["rolling"] = {"model": "epsd", "rolling_friction": 0.2, "stiffness": "iwashita_oda", "dashpot": False}
 json.dump(doc, open(sys.argv[2], "w"), indent=2)
+# the model named by the material pair (interactions[].rolling) instead of the subdomain's slot
+doc = json.load(open(sys.argv[1]))
+for sd in doc["subdomains"]:
+    pair_model = sd["contact"].pop("rolling")
+for it in doc["interactions"]:
+    it["rolling"] = pair_model
+json.dump(doc, open(sys.argv[2].replace("epsd2", "pair"), "w"), indent=2)
 EOF
-for variant in scenario scenario_epsd2; do
+for variant in scenario scenario_epsd2 scenario_pair; do
 echo "-- $variant.json"
 "$domel" run "$tmp/build/$variant.json" --out "$tmp/out_$variant" --quiet >"$tmp/run.log" 2>&1 || {
   rc=$?
@@ -64,7 +73,8 @@ import csv, json, os, sys
 out, module = sys.argv[1], sys.argv[2]
 s = json.load(open(os.path.join(out, "summary.json")))
 errors = []
-rolling = [(name, slots.get("rolling")) for name, slots in s["models"].items()]
+# the subdomain's rolling slot, or (scenario_pair) the model the pair (beads, beads) names
+rolling = [(name, slots.get("rolling") or slots.get("rolling (beads, beads)")) for name, slots in s["models"].items()]
 for name, r in rolling:
     if not r or r.get("model") != "epsd" or r.get("library") != "third_party_rolling":
         errors.append(f"subdomain '{name}': rolling slot is {r}, expected model 'epsd' from 'third_party_rolling'")

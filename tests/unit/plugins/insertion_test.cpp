@@ -2,6 +2,7 @@
 // Unit tests of the built-in insertion library (plugins/insertion): the
 // models are used directly through their C++ classes, and once through the
 // C callbacks the SDK generates for them (the ABI the host calls).
+#include "loader/plugin_registry.hpp"
 #include "plugins/insertion/lattice.hpp"
 #include "plugins/insertion/random_fill.hpp"
 #include "plugins/insertion/region.hpp"
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -631,4 +633,71 @@ TEST(InsertionDistribution, AMixturesParticlesCarryTheirComponentThroughEveryMod
     }
     Export::destroy(inst);
   }
+}
+
+namespace {
+
+/// An insertion model that reads a mixture but pushes its particles without
+/// their component, as a model built before ABI 2.4 would.
+class NoComponents {
+ public:
+  static constexpr domel_kind kKind = DOMEL_KIND_INSERTION;
+  static constexpr const char* kName = "no_components";
+  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kSummary = "test: a mixture without components";
+  static constexpr const char* kSchema = R"json({"type": "object"})json";
+  explicit NoComponents(const Params& p)
+      : d_(domel::sdk::SizeDistribution::parse(p.json().at("distribution"), "no_components")) {}
+  void insert(const domel_insert_request_v1& req, Inserted& out) const {
+    std::mt19937_64 rng(req.seed);
+    for (int k = 0; k < 10; ++k) out.push(0.01 * k, 0, 0, 0.5 * d_.sample(rng));
+  }
+
+ private:
+  domel::sdk::SizeDistribution d_;
+};
+
+template <class M>
+domel::platform::RegisteredModel registered() {
+  domel::platform::RegisteredModel m;
+  m.desc.kind = M::kKind;
+  m.desc.create = &domel::sdk::detail::Export<M>::create;
+  m.desc.destroy = &domel::sdk::detail::Export<M>::destroy;
+  m.insertion.insert = &domel::sdk::detail::Export<M>::insert;
+  m.name = M::kName;
+  m.library_name = "test";
+  return m;
+}
+
+}  // namespace
+
+// Guards the host's side of mixtures (ABI 2.4): asked for components, it
+// gets lattice's; a model that reads the mixture but names no component is
+// refused with a message that names the model and what to do.
+TEST(InsertionAbi, TheHostGetsEachParticlesComponentOrRefusesAModelThatNamesNone) {
+  const json mix = {{"distribution", {{"type", "mixture"}, {"by", "number"},
+                                      {"components", {{{"diameter", 1e-3}, {"fraction", 0.5}},
+                                                      {{"diameter", 2e-3}, {"fraction", 0.5}}}}}}};
+  const auto req = box_request(0, 0, 0, 0.01, 0.01, 0.01, 2);
+  std::vector<double> x, y, z, r;
+  std::vector<uint32_t> c;
+  const auto lattice = registered<Lattice>();
+  const domel::platform::ModelInstance good(lattice, mix, "here");
+  good.insert(req, x, y, z, r, &c);
+  ASSERT_EQ(c.size(), r.size());
+  ASSERT_GT(r.size(), 0u);
+  for (std::size_t k = 0; k < r.size(); ++k) EXPECT_EQ(r[k], c[k] == 0 ? 0.5e-3 : 1e-3);
+
+  const auto none = registered<NoComponents>();
+  const domel::platform::ModelInstance bad(none, mix, "here");
+  std::string why;
+  try {
+    bad.insert(req, x, y, z, r, &c);
+  } catch (const domel::platform::PluginError& e) {
+    why = e.what();
+  }
+  EXPECT_NE(why.find("insertion model 'no_components'"), std::string::npos) << why;
+  EXPECT_NE(why.find("did not say which component of the mixture each particle is"), std::string::npos) << why;
+  bad.insert(req, x, y, z, r);  // without a mixture to map, the host does not ask
+  EXPECT_EQ(r.size(), 10u);
 }
