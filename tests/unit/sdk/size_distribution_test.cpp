@@ -16,6 +16,7 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <string>
 #include <vector>
 
 using domel::sdk::ParameterError;
@@ -48,6 +49,16 @@ std::vector<double> draws(const SizeDistribution& s, std::uint64_t seed) {
 }
 
 const double kCritical = 1.63 / std::sqrt(static_cast<double>(kDraws));
+
+/// The message a block is refused with, as random would report it ("accepted" if it is not).
+std::string why(const json& j) {
+  try {
+    SizeDistribution::parse(j, "random: 'distribution'");
+  } catch (const ParameterError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
 
 }  // namespace
 
@@ -120,14 +131,6 @@ TEST(SizeDistribution, MeanCubeMatchesTheDraws) {
 }
 
 TEST(SizeDistribution, BadBlocksAreRefusedNamingTheKey) {
-  auto why = [](const json& j) {
-    try {
-      SizeDistribution::parse(j, "random: 'distribution'");
-    } catch (const ParameterError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_EQ(why({{"type", "table"}, {"diameters", {1e-3, 2e-3}}, {"fractions", {0.5, 0.6}}}),
             "random: 'distribution': expected 'fractions' summing to 1, found 1.1");
   EXPECT_EQ(why({{"type", "table"}, {"diameters", {1e-3, -2e-3}}, {"fractions", {0.5, 0.5}}}),
@@ -196,14 +199,6 @@ TEST(SizeDistribution, AMixtureDrawsEachComponentByItsShareAndFromItsOwnLaw) {
 }
 
 TEST(SizeDistribution, BadMixturesAreRefusedNamingTheComponent) {
-  auto why = [](const json& j) {
-    try {
-      SizeDistribution::parse(j, "random: 'distribution'");
-    } catch (const ParameterError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   const json a = {{"diameter", 1e-3}, {"fraction", 0.5}};
   EXPECT_EQ(why({{"type", "mixture"}, {"by", "mass"}, {"components", {a, {{"diameter", 2e-3}, {"fraction", 0.6}}}}}),
             "random: 'distribution': expected the components' 'fraction's summing to 1, found 1.1");
