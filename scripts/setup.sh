@@ -12,7 +12,7 @@ JOBS="${DOMEL_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 PACKAGES=(build-essential cmake ninja-build pkg-config
           libboost-dev libboost-filesystem-dev libeigen3-dev nlohmann-json3-dev libspdlog-dev
           libvtk9-dev libgtest-dev libgmock-dev json-schema-test-suite libhypre-dev
-          python3 python3-matplotlib)
+          libopenmpi-dev openmpi-bin python3 python3-matplotlib)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: MIT
+#include "distributed/communicator.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#ifdef DOMEL_HAVE_MPI
+// MPI's C API only: not the C++ bindings (removed in MPI-3) that OpenMPI's
+// and MPICH's mpi.h otherwise pull into a C++ translation unit
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
+#include <mpi.h>
+#endif
+
+namespace domel::platform {
+
+#ifdef DOMEL_HAVE_MPI
+struct Communicator::Impl {
+  MPI_Comm comm = MPI_COMM_WORLD;
+};
+
+namespace {
+void check(int rc, const char* what) {
+  if (rc != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
+}
+bool mpi_running() {
+  int init = 0, fin = 0;
+  MPI_Initialized(&init);
+  MPI_Finalized(&fin);
+  return init && !fin;
+}
+}  // namespace
+#else
+struct Communicator::Impl {};
+#endif
+
+Communicator::Communicator() = default;
+
+bool Communicator::built_with_mpi() {
+#ifdef DOMEL_HAVE_MPI
+  return true;
+#else
+  return false;
+#endif
+}
+
+Communicator Communicator::world() {
+  Communicator c;
+#ifdef DOMEL_HAVE_MPI
+  if (mpi_running()) {
+    auto impl = std::make_shared<Impl>();
+    check(MPI_Comm_rank(impl->comm, &c.rank_), "MPI_Comm_rank");
+    check(MPI_Comm_size(impl->comm, &c.size_), "MPI_Comm_size");
+    c.impl_ = std::move(impl);
+  }
+#endif
+  return c;
+}
+
+void Communicator::sum(std::vector<std::uint64_t>& v) const {
+  if (!impl_ || v.empty()) return;
+#ifdef DOMEL_HAVE_MPI
+  check(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_UINT64_T, MPI_SUM, impl_->comm),
+        "MPI_Allreduce");
+#endif
+}
+
+double Communicator::max(double v) const {
+#ifdef DOMEL_HAVE_MPI
+  if (impl_) check(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, impl_->comm), "MPI_Allreduce");
+#endif
+  return v;
+}
+
+double Communicator::min(double v) const {
+#ifdef DOMEL_HAVE_MPI
+  if (impl_) check(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MIN, impl_->comm), "MPI_Allreduce");
+#endif
+  return v;
+}
+
+std::vector<std::vector<char>> Communicator::all_to_all(const std::vector<std::vector<char>>& send) const {
+  if (send.size() != static_cast<std::size_t>(size_))
+    throw std::invalid_argument("Communicator::all_to_all: one buffer per rank expected");
+  if (!impl_) return send;
+  std::vector<std::vector<char>> recv(static_cast<std::size_t>(size_));
+#ifdef DOMEL_HAVE_MPI
+  const auto n = static_cast<std::size_t>(size_);
+  // counts first (as 64-bit, so that no buffer size overflows an int unseen)
+  std::vector<std::uint64_t> scount(n), rcount(n);
+  for (std::size_t r = 0; r < n; ++r) scount[r] = send[r].size();
+  check(MPI_Alltoall(scount.data(), 1, MPI_UINT64_T, rcount.data(), 1, MPI_UINT64_T, impl_->comm), "MPI_Alltoall");
+  std::vector<int> sc(n), sd(n), rc(n), rd(n);
+  std::uint64_t stotal = 0, rtotal = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    sd[r] = static_cast<int>(stotal);
+    rd[r] = static_cast<int>(rtotal);
+    sc[r] = static_cast<int>(scount[r]);
+    rc[r] = static_cast<int>(rcount[r]);
+    stotal += scount[r];
+    rtotal += rcount[r];
+  }
+  if (stotal > static_cast<std::uint64_t>(INT32_MAX) || rtotal > static_cast<std::uint64_t>(INT32_MAX))
+    throw std::runtime_error("MPI: an exchange of more than 2 GiB in one step");
+  std::vector<char> sbuf(stotal), rbuf(rtotal);
+  for (std::size_t r = 0; r < n; ++r) std::copy(send[r].begin(), send[r].end(), sbuf.begin() + sd[r]);
+  check(MPI_Alltoallv(sbuf.data(), sc.data(), sd.data(), MPI_CHAR, rbuf.data(), rc.data(), rd.data(), MPI_CHAR,
+                      impl_->comm),
+        "MPI_Alltoallv");
+  for (std::size_t r = 0; r < n; ++r) recv[r].assign(rbuf.begin() + rd[r], rbuf.begin() + rd[r] + rc[r]);
+#endif
+  return recv;
+}
+
+std::vector<std::vector<char>> Communicator::all_gather(const std::vector<char>& mine) const {
+  return all_to_all(std::vector<std::vector<char>>(static_cast<std::size_t>(size_), mine));
+}
+
+void Communicator::barrier() const {
+#ifdef DOMEL_HAVE_MPI
+  if (impl_) check(MPI_Barrier(impl_->comm), "MPI_Barrier");
+#endif
+}
+
+MpiSession::MpiSession(int* argc, char*** argv, bool use) {
+#ifdef DOMEL_HAVE_MPI
+  if (use && !mpi_running()) {
+    check(MPI_Init(argc, argv), "MPI_Init");
+    initialised_ = true;
+  }
+#else
+  (void)argc;
+  (void)argv;
+  (void)use;
+#endif
+}
+
+MpiSession::~MpiSession() {
+#ifdef DOMEL_HAVE_MPI
+  if (initialised_) MPI_Finalize();
+#endif
+}
+
+}  // namespace domel::platform
