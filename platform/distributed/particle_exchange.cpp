@@ -72,10 +72,22 @@ ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communica
   return c;
 }
 
-ExchangeCounts exchange_ghosts(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d,
-                               double cutoff, const Communicator& comm) {
+namespace {
+/// Values of `arrays` for the particles `which`, particle-major.
+std::vector<char> gather_values(const std::vector<const std::vector<double>*>& arrays,
+                                const std::vector<std::uint32_t>& which) {
+  std::vector<char> out(which.size() * arrays.size() * sizeof(double));
+  auto* p = reinterpret_cast<double*>(out.data());
+  for (std::uint32_t k : which)
+    for (const auto* a : arrays) *p++ = (*a)[k];
+  return out;
+}
+}  // namespace
+
+ExchangeCounts GhostExchange::build(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d,
+                                    double cutoff, const Communicator& comm) {
   const auto nr = static_cast<std::size_t>(comm.size());
-  std::vector<std::vector<std::uint32_t>> copies(nr);
+  sent_.assign(nr, {});
   std::vector<int> near;
   ExchangeCounts c;
   for (std::size_t k = 0; k < owned.size(); ++k) {
@@ -83,22 +95,67 @@ ExchangeCounts exchange_ghosts(const ParticleStore& owned, ParticleStore& ghosts
     d.parts_within(p, cutoff, near);
     for (int r : near)
       if (r != comm.rank() && static_cast<std::size_t>(r) < nr) {
-        copies[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(k));
+        sent_[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(k));
         ++c.sent;
       }
   }
   std::vector<std::vector<char>> send(nr);
-  for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(owned, copies[r]);
+  for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(owned, sent_[r]);
   ghosts = ParticleStore{};
   if (owned.has_external_force()) ghosts.enable_external_force();
   ghosts.add_aux(owned.aux.size());
   const auto recv = comm.all_to_all(send);
   const std::size_t per = particle_bytes(owned);
-  for (const auto& b : recv) {
-    unpack_particles(ghosts, b);
-    c.received += b.size() / per;
+  first_.assign(nr + 1, 0);
+  for (std::size_t r = 0; r < nr; ++r) {
+    first_[r] = ghosts.size();
+    unpack_particles(ghosts, recv[r]);
+    c.received += recv[r].size() / per;
   }
+  first_[nr] = ghosts.size();
+  ghosts_ = ghosts.size();
   return c;
+}
+
+void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, const Communicator& comm) const {
+  if (ghosts.size() != ghosts_) throw std::logic_error("GhostExchange::update: the ghosts changed since build()");
+  const std::vector<const std::vector<double>*> motion = {&owned.x,  &owned.y,  &owned.z,  &owned.vx, &owned.vy,
+                                                          &owned.vz, &owned.wx, &owned.wy, &owned.wz};
+  std::vector<std::vector<char>> send(sent_.size());
+  for (std::size_t r = 0; r < sent_.size(); ++r) send[r] = gather_values(motion, sent_[r]);
+  const auto recv = comm.all_to_all(send);
+  std::vector<double>* into[9] = {&ghosts.x,  &ghosts.y,  &ghosts.z,  &ghosts.vx, &ghosts.vy,
+                                  &ghosts.vz, &ghosts.wx, &ghosts.wy, &ghosts.wz};
+  for (std::size_t r = 0; r < recv.size(); ++r) {
+    const std::size_t n = first_[r + 1] - first_[r];
+    if (recv[r].size() != n * 9 * sizeof(double))
+      throw std::runtime_error("GhostExchange::update: rank " + std::to_string(r) + " sent another number of ghosts");
+    const auto* p = reinterpret_cast<const double*>(recv[r].data());
+    for (std::size_t g = first_[r]; g < first_[r + 1]; ++g)
+      for (auto* a : into) (*a)[g] = *p++;
+  }
+}
+
+void GhostExchange::reverse(const ParticleStore& ghosts, ParticleStore& owned, const Communicator& comm) const {
+  if (ghosts.size() != ghosts_) throw std::logic_error("GhostExchange::reverse: the ghosts changed since build()");
+  const std::vector<const std::vector<double>*> loads = {&ghosts.fx, &ghosts.fy, &ghosts.fz,
+                                                         &ghosts.tx, &ghosts.ty, &ghosts.tz};
+  const std::size_t nr = sent_.size();
+  std::vector<std::vector<char>> send(nr);
+  for (std::size_t r = 0; r < nr; ++r) {
+    std::vector<std::uint32_t> mine(first_[r + 1] - first_[r]);
+    for (std::size_t g = 0; g < mine.size(); ++g) mine[g] = static_cast<std::uint32_t>(first_[r] + g);
+    send[r] = gather_values(loads, mine);
+  }
+  const auto recv = comm.all_to_all(send);
+  std::vector<double>* into[6] = {&owned.fx, &owned.fy, &owned.fz, &owned.tx, &owned.ty, &owned.tz};
+  for (std::size_t r = 0; r < nr; ++r) {  // in rank order: fixed sums
+    if (recv[r].size() != sent_[r].size() * 6 * sizeof(double))
+      throw std::runtime_error("GhostExchange::reverse: rank " + std::to_string(r) + " returned another number of ghosts");
+    const auto* p = reinterpret_cast<const double*>(recv[r].data());
+    for (std::uint32_t k : sent_[r])
+      for (auto* a : into) (*a)[k] += *p++;
+  }
 }
 
 }  // namespace domel::platform

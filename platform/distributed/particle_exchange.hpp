@@ -32,10 +32,31 @@ struct ExchangeCounts {
 /// Collective.
 ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communicator& comm);
 
-/// The ghosts of this rank: copies of other ranks' particles within `cutoff`
-/// of its region, by sending rank, each in its store order (`ghosts` is
-/// replaced; its layout follows `owned`). Collective.
-ExchangeCounts exchange_ghosts(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d,
-                               double cutoff, const Communicator& comm);
+/// The ghosts of a rank and the way back to their owners. build() sends
+/// copies of the owned particles within `cutoff` of other ranks' regions and
+/// keeps who went where, so that between rebuilds update() refreshes the
+/// ghosts' motion (the forward exchange, the step's ghost_update phase) and
+/// reverse() adds the forces and torques the ghosts collected to their
+/// owners (the reverse_exchange phase), in the order of the sending ranks:
+/// the same sums every run for a given rank count.
+class GhostExchange {
+ public:
+  /// Replace `ghosts` (layout as `owned`) by this rank's ghosts, by sending
+  /// rank, each in its store order. Collective.
+  ExchangeCounts build(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d, double cutoff,
+                       const Communicator& comm);
+  /// Positions, velocities and angular velocities of the owners into their
+  /// ghosts (same particles as at build()). Collective.
+  void update(const ParticleStore& owned, ParticleStore& ghosts, const Communicator& comm) const;
+  /// The ghosts' forces and torques added to their owners'. Collective.
+  void reverse(const ParticleStore& ghosts, ParticleStore& owned, const Communicator& comm) const;
+  /// The ghosts this rank holds since the last build().
+  std::size_t ghost_count() const { return ghosts_; }
+
+ private:
+  std::vector<std::vector<std::uint32_t>> sent_;  ///< per rank: the owned particles it holds as ghosts
+  std::vector<std::size_t> first_;                ///< per rank: its first ghost here (and the total at the end)
+  std::size_t ghosts_ = 0;
+};
 
 }  // namespace domel::platform

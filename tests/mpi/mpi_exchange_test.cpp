@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <set>
@@ -117,7 +119,8 @@ TEST(Mpi, WithTheGhostsEachClosePairIsCompleteOnExactlyOneRank) {
   const dp::Decomposition d = decompose(s, comm);
   dp::migrate(s, d, comm);
   dp::ParticleStore ghosts;
-  dp::exchange_ghosts(s, ghosts, d, kCutoff, comm);
+  dp::GhostExchange exchange;
+  exchange.build(s, ghosts, d, kCutoff, comm);
   // ghosts are other ranks' particles, each once
   std::unordered_set<std::uint64_t> owned(s.id.begin(), s.id.end()), here = owned;
   for (std::uint64_t id : ghosts.id) {
@@ -147,6 +150,106 @@ TEST(Mpi, WithTheGhostsEachClosePairIsCompleteOnExactlyOneRank) {
   comm.sum(total);
   EXPECT_EQ(total[0], close_pairs);  // every close pair once over all ranks
   EXPECT_GT(close_pairs, 1000u);     // the check has something to check
+}
+
+namespace {
+/// A test load between particles a and b closer than rc: a spring on the
+/// gap along the line of centres, and a torque on each that depends on the
+/// pair (so that torques travel home too). Returns false beyond rc.
+bool load(const double a[3], const double b[3], double rc, double f[3], double t[3]) {
+  const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (r >= rc) return false;
+  for (int k = 0; k < 3; ++k) {
+    f[k] = 1e3 * (rc - r) * d[k] / r;
+    t[k] = 1e-2 * (rc - r) * (k + 1);
+  }
+  return true;
+}
+/// Particle g after a small move (at most 1e-4 m along each axis).
+void moved(std::size_t g, double p[3]) {
+  particle(g, p);
+  p[0] += 1e-4 * std::sin(1.0 * g);
+  p[1] += 1e-4 * std::cos(2.0 * g);
+  p[2] -= 1e-4 * std::sin(3.0 * g);
+}
+}  // namespace
+
+TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) {
+  const dp::Communicator comm = dp::Communicator::world();
+  dp::ParticleStore s = share(comm, false);
+  const dp::Decomposition d = decompose(s, comm);
+  dp::migrate(s, d, comm);
+  dp::ParticleStore ghosts;
+  dp::GhostExchange gx;
+  gx.build(s, ghosts, d, kCutoff, comm);
+  // the owners move (less than the list's skin would allow) and the ghosts follow
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    double p[3];
+    moved(s.id[k], p);
+    s.x[k] = p[0]; s.y[k] = p[1]; s.z[k] = p[2];
+    s.wz[k] = static_cast<double>(s.id[k]);
+  }
+  gx.update(s, ghosts, comm);
+  for (std::size_t k = 0; k < ghosts.size(); ++k) {
+    double p[3];
+    moved(ghosts.id[k], p);
+    EXPECT_EQ(ghosts.x[k], p[0]);
+    EXPECT_EQ(ghosts.z[k], p[2]);
+    EXPECT_EQ(ghosts.wz[k], static_cast<double>(ghosts.id[k]));
+  }
+  // pair loads on owned + ghosts: the rank owning the lower id computes the
+  // pair; each moved by at most sqrt(3) 1e-4, so pairs within this range were
+  // within the ghost cut-off when the ghosts were built
+  const double rc = kCutoff - 2.0 * std::sqrt(3.0) * 1e-4;
+  for (auto* st : {&s, &ghosts})
+    for (auto* a : {&st->fx, &st->fy, &st->fz, &st->tx, &st->ty, &st->tz}) std::fill(a->begin(), a->end(), 0.0);
+  const std::size_t no = s.size(), nall = no + ghosts.size();
+  auto at = [&](std::size_t k, double p[3]) {
+    const dp::ParticleStore& st = k < no ? s : ghosts;
+    const std::size_t i = k < no ? k : k - no;
+    p[0] = st.x[i]; p[1] = st.y[i]; p[2] = st.z[i];
+  };
+  auto add = [&](std::size_t k, const double f[3], const double t[3], double sign) {
+    dp::ParticleStore& st = k < no ? s : ghosts;
+    const std::size_t i = k < no ? k : k - no;
+    st.fx[i] += sign * f[0]; st.fy[i] += sign * f[1]; st.fz[i] += sign * f[2];
+    st.tx[i] += t[0]; st.ty[i] += t[1]; st.tz[i] += t[2];
+  };
+  for (std::size_t a = 0; a < no; ++a)
+    for (std::size_t b = 0; b < nall; ++b) {
+      const std::uint64_t ia = s.id[a], ib = b < no ? s.id[b] : ghosts.id[b - no];
+      if (ia >= ib) continue;  // the lower id is owned here: this rank computes the pair
+      double pa[3], pb[3], f[3], t[3];
+      at(a, pa);
+      at(b, pb);
+      if (!load(pa, pb, rc, f, t)) continue;
+      add(a, f, t, 1.0);
+      add(b, f, t, -1.0);
+    }
+  gx.reverse(ghosts, s, comm);
+  // one process, same loads
+  std::vector<double> fx(kTotal, 0.0), tz(kTotal, 0.0);
+  std::vector<std::array<double, 3>> pos(kTotal);
+  for (std::size_t g = 0; g < kTotal; ++g) moved(g, pos[g].data());
+  for (std::size_t i = 0; i < kTotal; ++i)
+    for (std::size_t j = i + 1; j < kTotal; ++j) {
+      double f[3], t[3];
+      if (!load(pos[i].data(), pos[j].data(), rc, f, t)) continue;
+      fx[i] += f[0]; fx[j] -= f[0];
+      tz[i] += t[2]; tz[j] += t[2];
+    }
+  std::size_t loaded = 0;
+  for (std::size_t k = 0; k < no; ++k) {
+    const std::uint64_t g = s.id[k];
+    // the same terms summed in another order: equal to round-off (1e-12 of the largest term)
+    EXPECT_NEAR(s.fx[k], fx[g], 1e-12 * 1e3 * kCutoff * 10) << "particle " << g;
+    EXPECT_NEAR(s.tz[k], tz[g], 1e-12 * 1e-2 * kCutoff * 3 * 10) << "particle " << g;
+    loaded += tz[g] != 0.0 ? 1 : 0;
+  }
+  std::vector<std::uint64_t> n{loaded};
+  comm.sum(n);
+  EXPECT_GT(n[0], kTotal / 4);  // most particles carry a load: the check has something to check
 }
 
 int main(int argc, char** argv) {

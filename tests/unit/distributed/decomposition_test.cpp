@@ -189,7 +189,8 @@ TEST(ParticleExchange, OneRankKeepsItsParticlesAndHasNoGhosts) {
   EXPECT_EQ(m.sent, 0u);
   EXPECT_EQ(s.size(), 4u);
   dp::ParticleStore ghosts;
-  const auto g = dp::exchange_ghosts(s, ghosts, d, 0.01, one);
+  dp::GhostExchange gx;
+  const auto g = gx.build(s, ghosts, d, 0.01, one);
   EXPECT_EQ(g.received, 0u);
   EXPECT_EQ(ghosts.size(), 0u);
 }
