@@ -165,14 +165,21 @@ int Decomposition::owner(const double p[3]) const {
   return nodes_[id].first;
 }
 
-void Decomposition::parts_within(const double p[3], double cutoff, std::vector<int>& out) const {
+void Decomposition::parts_within(const double p[3], double cutoff, std::vector<int>& out,
+                                 const PeriodicBox& box) const {
   out.clear();
   std::vector<std::size_t> stack{0};
   while (!stack.empty()) {
     const std::size_t id = stack.back();
     stack.pop_back();
     const Node& nd = nodes_[id];
-    if (nd.region.distance(p) > cutoff) continue;
+    Region r = nd.region;
+    for (int a = 0; a < 3; ++a)
+      if (box.axis[a]) {
+        r.lo[a] = std::max(r.lo[a], box.lo[a]);
+        r.hi[a] = std::min(r.hi[a], box.hi[a]);
+      }
+    if (r.distance(p) > cutoff) continue;
     if (nd.left < 0) {
       out.push_back(nd.first);
     } else {

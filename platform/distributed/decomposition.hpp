@@ -14,6 +14,7 @@
 // infinity, so a particle that strays out of the extent still has an owner.
 #pragma once
 
+#include "core/neighbor_list.hpp"
 #include "distributed/communicator.hpp"
 
 #include <cstddef>
@@ -47,8 +48,10 @@ class Decomposition {
   /// Part k's region (outer faces at +-infinity).
   const Region& region(int part) const { return nodes_[leaf_[static_cast<std::size_t>(part)]].region; }
   /// Every part whose region lies within `cutoff` of p (the owner included),
-  /// ascending, into `out` (cleared first).
-  void parts_within(const double p[3], double cutoff, std::vector<int>& out) const;
+  /// ascending, into `out` (cleared first). With a periodic box, the regions
+  /// end at its faces along its periodic axes (there, beyond a face is the
+  /// other side's image, not more of the region).
+  void parts_within(const double p[3], double cutoff, std::vector<int>& out, const PeriodicBox& box = {}) const;
 
   struct Node {
     Region region;  ///< what it owns (outer faces at infinity)

@@ -2,6 +2,7 @@
 #include "distributed/particle_exchange.hpp"
 
 #include <cstring>
+#include <type_traits>
 #include <stdexcept>
 #include <string>
 
@@ -13,14 +14,22 @@ std::size_t particle_bytes(const ParticleStore& s) {
   return b;
 }
 
-std::vector<char> pack_particles(const ParticleStore& s, const std::vector<std::uint32_t>& which) {
+std::vector<char> pack_particles(const ParticleStore& s, const std::vector<std::uint32_t>& which,
+                                 const std::vector<std::array<double, 3>>* shift) {
   std::vector<char> out(which.size() * particle_bytes(s));
   char* p = out.data();
+  const void* position[3] = {&s.x, &s.y, &s.z};
   // array-major within the buffer: one pass per array
   s.for_each_array([&](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::value_type;
-    for (std::uint32_t k : which) {
-      std::memcpy(p, &v[k], sizeof(T));
+    int axis = -1;
+    for (int a = 0; a < 3; ++a)
+      if (static_cast<const void*>(&v) == position[a]) axis = a;
+    for (std::size_t q = 0; q < which.size(); ++q) {
+      T value = v[which[q]];
+      if constexpr (std::is_same_v<T, double>)
+        if (shift && axis >= 0) value += (*shift)[q][static_cast<std::size_t>(axis)];
+      std::memcpy(p, &value, sizeof(T));
       p += sizeof(T);
     }
   });
@@ -85,22 +94,35 @@ std::vector<char> gather_values(const std::vector<const std::vector<double>*>& a
 }  // namespace
 
 ExchangeCounts GhostExchange::build(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d,
-                                    double cutoff, const Communicator& comm) {
+                                    double cutoff, const Communicator& comm, const PeriodicBox& box) {
   const auto nr = static_cast<std::size_t>(comm.size());
   sent_.assign(nr, {});
+  shift_.assign(nr, {});
+  double period[3], inv[3];
+  box.periods(period, inv);
+  for (int a = 0; a < 3; ++a)
+    if (box.axis[a] && period[a] < 2.0 * cutoff)
+      throw std::invalid_argument("GhostExchange: a periodic axis shorter than twice the ghost cut-off");
+  std::vector<std::array<double, 3>> shifts{{0.0, 0.0, 0.0}};
+  for (const auto& s : box.image_shifts()) shifts.push_back({s[0] * period[0], s[1] * period[1], s[2] * period[2]});
   std::vector<int> near;
   ExchangeCounts c;
-  for (std::size_t k = 0; k < owned.size(); ++k) {
-    const double p[3] = {owned.x[k], owned.y[k], owned.z[k]};
-    d.parts_within(p, cutoff, near);
-    for (int r : near)
-      if (r != comm.rank() && static_cast<std::size_t>(r) < nr) {
-        sent_[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(k));
-        ++c.sent;
-      }
-  }
+  for (std::size_t k = 0; k < owned.size(); ++k)
+    for (std::size_t i = 0; i < shifts.size(); ++i) {
+      const auto& sh = shifts[i];
+      const double p[3] = {owned.x[k] + sh[0], owned.y[k] + sh[1], owned.z[k] + sh[2]};
+      d.parts_within(p, cutoff, near, box);
+      for (int r : near)
+        if ((r != comm.rank() || i > 0) && static_cast<std::size_t>(r) < nr) {
+          sent_[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(k));
+          shift_[static_cast<std::size_t>(r)].push_back(sh);
+          ++c.sent;
+        }
+    }
   std::vector<std::vector<char>> send(nr);
-  for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(owned, sent_[r]);
+  for (std::size_t r = 0; r < nr; ++r) {
+    send[r] = pack_particles(owned, sent_[r], &shift_[r]);
+  }
   ghosts = ParticleStore{};
   if (owned.has_external_force()) ghosts.enable_external_force();
   ghosts.add_aux(owned.aux.size());
@@ -122,7 +144,12 @@ void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, co
   const std::vector<const std::vector<double>*> motion = {&owned.x,  &owned.y,  &owned.z,  &owned.vx, &owned.vy,
                                                           &owned.vz, &owned.wx, &owned.wy, &owned.wz};
   std::vector<std::vector<char>> send(sent_.size());
-  for (std::size_t r = 0; r < sent_.size(); ++r) send[r] = gather_values(motion, sent_[r]);
+  for (std::size_t r = 0; r < sent_.size(); ++r) {
+    send[r] = gather_values(motion, sent_[r]);
+    auto* v = reinterpret_cast<double*>(send[r].data());
+    for (std::size_t q = 0; q < sent_[r].size(); ++q)
+      for (std::size_t a = 0; a < 3; ++a) v[q * motion.size() + a] += shift_[r][q][a];  // images: shifted positions
+  }
   const auto recv = comm.all_to_all(send);
   std::vector<double>* into[9] = {&ghosts.x,  &ghosts.y,  &ghosts.z,  &ghosts.vx, &ghosts.vy,
                                   &ghosts.vz, &ghosts.wx, &ghosts.wy, &ghosts.wz};

@@ -153,11 +153,10 @@ TEST(Mpi, WithTheGhostsEachClosePairIsCompleteOnExactlyOneRank) {
 }
 
 namespace {
-/// A test load between particles a and b closer than rc: a spring on the
+/// A test load between particles at separation d closer than rc: a spring on the
 /// gap along the line of centres, and a torque on each that depends on the
 /// pair (so that torques travel home too). Returns false beyond rc.
-bool load(const double a[3], const double b[3], double rc, double f[3], double t[3]) {
-  const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+bool load(const double d[3], double rc, double f[3], double t[3]) {
   const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   if (r >= rc) return false;
   for (int k = 0; k < 3; ++k) {
@@ -175,14 +174,19 @@ void moved(std::size_t g, double p[3]) {
 }
 }  // namespace
 
-TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) {
+namespace {
+/// Build the ghosts (through the faces of `box` where periodic), move the
+/// owners, update the ghosts, compute pair loads on owned + ghosts, send the
+/// ghosts' home, and compare with the same loads on one process (nearest
+/// images through periodic faces).
+void ghosts_follow_and_forces_go_home(const dp::PeriodicBox& box) {
   const dp::Communicator comm = dp::Communicator::world();
   dp::ParticleStore s = share(comm, false);
   const dp::Decomposition d = decompose(s, comm);
   dp::migrate(s, d, comm);
   dp::ParticleStore ghosts;
   dp::GhostExchange gx;
-  gx.build(s, ghosts, d, kCutoff, comm);
+  gx.build(s, ghosts, d, kCutoff, comm, box);
   // the owners move (less than the list's skin would allow) and the ghosts follow
   for (std::size_t k = 0; k < s.size(); ++k) {
     double p[3];
@@ -194,8 +198,14 @@ TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) {
   for (std::size_t k = 0; k < ghosts.size(); ++k) {
     double p[3];
     moved(ghosts.id[k], p);
-    EXPECT_EQ(ghosts.x[k], p[0]);
-    EXPECT_EQ(ghosts.z[k], p[2]);
+    // the owner's position, or an image of it a whole period away
+    double L[3], inv_L[3];
+    box.periods(L, inv_L);
+    for (int a = 0; a < 3; ++a) {
+      const double at = a == 0 ? ghosts.x[k] : a == 1 ? ghosts.y[k] : ghosts.z[k];
+      EXPECT_NEAR(dp::min_image(at - p[a], L[a], inv_L[a]), 0.0, 1e-15);
+      if (!box.axis[a]) EXPECT_EQ(at, p[a]);
+    }
     EXPECT_EQ(ghosts.wz[k], static_cast<double>(ghosts.id[k]));
   }
   // pair loads on owned + ghosts: the rank owning the lower id computes the
@@ -223,7 +233,8 @@ TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) {
       double pa[3], pb[3], f[3], t[3];
       at(a, pa);
       at(b, pb);
-      if (!load(pa, pb, rc, f, t)) continue;
+      const double sep[3] = {pa[0] - pb[0], pa[1] - pb[1], pa[2] - pb[2]};  // images carry their shift
+      if (!load(sep, rc, f, t)) continue;
       add(a, f, t, 1.0);
       add(b, f, t, -1.0);
     }
@@ -231,11 +242,20 @@ TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) {
   // one process, same loads
   std::vector<double> fx(kTotal, 0.0), tz(kTotal, 0.0);
   std::vector<std::array<double, 3>> pos(kTotal);
+  double period[3], inv[3];
+  box.periods(period, inv);
+  std::uint64_t through = 0;
   for (std::size_t g = 0; g < kTotal; ++g) moved(g, pos[g].data());
   for (std::size_t i = 0; i < kTotal; ++i)
     for (std::size_t j = i + 1; j < kTotal; ++j) {
-      double f[3], t[3];
-      if (!load(pos[i].data(), pos[j].data(), rc, f, t)) continue;
+      double f[3], t[3], sep[3];
+      bool face = false;
+      for (int a = 0; a < 3; ++a) {
+        sep[a] = dp::min_image(pos[i][a] - pos[j][a], period[a], inv[a]);
+        face = face || sep[a] != pos[i][a] - pos[j][a];
+      }
+      if (!load(sep, rc, f, t)) continue;
+      through += face ? 1 : 0;
       fx[i] += f[0]; fx[j] -= f[0];
       tz[i] += t[2]; tz[j] += t[2];
     }
@@ -250,7 +270,22 @@ TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) {
   std::vector<std::uint64_t> n{loaded};
   comm.sum(n);
   EXPECT_GT(n[0], kTotal / 4);  // most particles carry a load: the check has something to check
+  if (box.any()) EXPECT_GT(through, 100u);  // and many of them through a periodic face
 }
+
+}  // namespace
+
+TEST(Mpi, GhostsFollowTheirOwnersAndTheirForcesGoHome) { ghosts_follow_and_forces_go_home({}); }
+
+TEST(Mpi, ThroughPeriodicFacesGhostsAreImagesAndForcesEqualTheNearestImages) {
+  dp::PeriodicBox box;
+  box.axis[0] = box.axis[1] = true;
+  box.hi[0] = 0.08;
+  box.hi[1] = 0.06;
+  box.hi[2] = 0.2;
+  ghosts_follow_and_forces_go_home(box);
+}
+
 
 int main(int argc, char** argv) {
   dp::MpiSession mpi(&argc, &argv);

@@ -194,3 +194,20 @@ TEST(ParticleExchange, OneRankKeepsItsParticlesAndHasNoGhosts) {
   EXPECT_EQ(g.received, 0u);
   EXPECT_EQ(ghosts.size(), 0u);
 }
+
+TEST(ParticleExchange, OneRankWithAPeriodicAxisHoldsImagesOfItsOwnParticlesNearTheFaces) {
+  dp::ParticleStore s;
+  s.add(1, 0.001, 0.05, 0.05, 0.001, 2500.0);  // near the face x = 0
+  s.add(2, 0.050, 0.05, 0.05, 0.001, 2500.0);  // in the middle
+  dp::PeriodicBox box;
+  box.axis[0] = true;
+  box.hi[0] = box.hi[1] = box.hi[2] = 0.1;
+  dp::ParticleStore ghosts;
+  dp::GhostExchange gx;
+  gx.build(s, ghosts, dp::Decomposition{}, 0.01, dp::Communicator{}, box);
+  ASSERT_EQ(ghosts.size(), 1u);  // particle 1's image one period along +x
+  EXPECT_EQ(ghosts.id[0], 1u);
+  EXPECT_DOUBLE_EQ(ghosts.x[0], 0.101);
+  box.hi[0] = 0.015;  // shorter than twice the cut-off: images would not be unique
+  EXPECT_THROW(gx.build(s, ghosts, dp::Decomposition{}, 0.01, dp::Communicator{}, box), std::invalid_argument);
+}
