@@ -71,6 +71,20 @@ std::vector<char> bytes_of(const std::vector<double>& v) {
   return b;
 }
 
+/// The particles of this rank after migration, with their ghosts.
+struct Distributed {
+  Distributed(bool blocks, const dp::PeriodicBox& box = {})
+      : comm(dp::Communicator::world()), s(share(comm, blocks)), d(decompose(s, comm)) {
+    dp::migrate(s, d, comm);
+    gx.build(s, ghosts, d, kCutoff, comm, box);
+  }
+  dp::Communicator comm;
+  dp::ParticleStore s;
+  dp::Decomposition d;
+  dp::ParticleStore ghosts;
+  dp::GhostExchange gx;
+};
+
 }  // namespace
 
 TEST(Mpi, EveryRankComputesTheSameTreeWhateverItHolds) {
@@ -114,13 +128,10 @@ TEST(Mpi, MigrationKeepsEveryParticleOnceOnItsOwner) {
 }
 
 TEST(Mpi, WithTheGhostsEachClosePairIsCompleteOnExactlyOneRank) {
-  const dp::Communicator comm = dp::Communicator::world();
-  dp::ParticleStore s = share(comm, true);
-  const dp::Decomposition d = decompose(s, comm);
-  dp::migrate(s, d, comm);
-  dp::ParticleStore ghosts;
-  dp::GhostExchange exchange;
-  exchange.build(s, ghosts, d, kCutoff, comm);
+  Distributed run(true);
+  const dp::Communicator& comm = run.comm;
+  const dp::ParticleStore& s = run.s;
+  const dp::ParticleStore& ghosts = run.ghosts;
   // ghosts are other ranks' particles, each once
   std::unordered_set<std::uint64_t> owned(s.id.begin(), s.id.end()), here = owned;
   for (std::uint64_t id : ghosts.id) {
@@ -180,13 +191,11 @@ namespace {
 /// ghosts' home, and compare with the same loads on one process (nearest
 /// images through periodic faces).
 void ghosts_follow_and_forces_go_home(const dp::PeriodicBox& box) {
-  const dp::Communicator comm = dp::Communicator::world();
-  dp::ParticleStore s = share(comm, false);
-  const dp::Decomposition d = decompose(s, comm);
-  dp::migrate(s, d, comm);
-  dp::ParticleStore ghosts;
-  dp::GhostExchange gx;
-  gx.build(s, ghosts, d, kCutoff, comm, box);
+  Distributed run(false, box);
+  const dp::Communicator& comm = run.comm;
+  dp::ParticleStore& s = run.s;
+  dp::ParticleStore& ghosts = run.ghosts;
+  const dp::GhostExchange& gx = run.gx;
   // the owners move (less than the list's skin would allow) and the ghosts follow
   for (std::size_t k = 0; k < s.size(); ++k) {
     double p[3];
