@@ -54,6 +54,16 @@ void unpack_particles(ParticleStore& s, const std::vector<char>& bytes) {
   ++s.layout_version;
 }
 
+std::uint64_t claim_ids(std::uint64_t count, std::uint64_t& next_id, const Communicator& comm) {
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(comm.size()), 0);
+  counts[static_cast<std::size_t>(comm.rank())] = count;
+  comm.sum(counts);  // every rank's count, on every rank
+  std::uint64_t first = next_id;
+  for (int r = 0; r < comm.rank(); ++r) first += counts[static_cast<std::size_t>(r)];
+  for (std::uint64_t c : counts) next_id += c;
+  return first;
+}
+
 ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communicator& comm) {
   const auto nr = static_cast<std::size_t>(comm.size());
   std::vector<std::vector<std::uint32_t>> leaving(nr);

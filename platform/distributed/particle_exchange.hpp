@@ -27,6 +27,12 @@ std::vector<char> pack_particles(const ParticleStore& s, const std::vector<std::
 /// the same external-force switch and aux count) to s.
 void unpack_particles(ParticleStore& s, const std::vector<char>& bytes);
 
+/// Ids for `count` new particles of this rank (a pour, an inflow) that are
+/// unique over all ranks: rank r's block follows those of ranks 0..r-1, and
+/// `next_id`, the same on every rank before and after, advances by the total.
+/// Returns this rank's first id. Collective.
+std::uint64_t claim_ids(std::uint64_t count, std::uint64_t& next_id, const Communicator& comm);
+
 struct ExchangeCounts {
   std::size_t sent = 0, received = 0;
 };

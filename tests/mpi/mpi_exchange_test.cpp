@@ -163,6 +163,23 @@ TEST(Mpi, WithTheGhostsEachClosePairIsCompleteOnExactlyOneRank) {
   EXPECT_GT(close_pairs, 1000u);     // the check has something to check
 }
 
+TEST(Mpi, IdsClaimedByEveryRankAreUniqueAndContiguous) {
+  const dp::Communicator comm = dp::Communicator::world();
+  std::uint64_t next = 100;
+  std::vector<std::uint64_t> mine;
+  for (int round = 0; round < 3; ++round) {
+    const std::uint64_t n = static_cast<std::uint64_t>((comm.rank() + round) % 3);  // some ranks claim none
+    const std::uint64_t first = dp::claim_ids(n, next, comm);
+    for (std::uint64_t k = 0; k < n; ++k) mine.push_back(first + k);
+  }
+  std::vector<std::uint64_t> seen(static_cast<std::size_t>(next - 100), 0), after{next};
+  for (std::uint64_t id : mine) ++seen[static_cast<std::size_t>(id - 100)];
+  comm.sum(seen);
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](std::uint64_t c) { return c == 1; }));  // no gap, no twin
+  comm.sum(after);
+  EXPECT_EQ(after[0], next * static_cast<std::uint64_t>(comm.size()));  // the same next_id everywhere
+}
+
 namespace {
 /// A test load between particles at separation d closer than rc: a spring on the
 /// gap along the line of centres, and a torque on each that depends on the

@@ -211,3 +211,11 @@ TEST(ParticleExchange, OneRankWithAPeriodicAxisHoldsImagesOfItsOwnParticlesNearT
   box.hi[0] = 0.015;  // shorter than twice the cut-off: images would not be unique
   EXPECT_THROW(gx.build(s, ghosts, dp::Decomposition{}, 0.01, dp::Communicator{}, box), std::invalid_argument);
 }
+
+TEST(ParticleExchange, OneRankClaimsIdsInSequence) {
+  std::uint64_t next = 7;
+  EXPECT_EQ(dp::claim_ids(3, next, dp::Communicator{}), 7u);
+  EXPECT_EQ(next, 10u);
+  EXPECT_EQ(dp::claim_ids(0, next, dp::Communicator{}), 10u);
+  EXPECT_EQ(next, 10u);
+}
