@@ -65,20 +65,6 @@ void Communicator::sum(std::vector<std::uint64_t>& v) const {
 #endif
 }
 
-double Communicator::max(double v) const {
-#ifdef DOMEL_HAVE_MPI
-  if (impl_) check(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, impl_->comm), "MPI_Allreduce");
-#endif
-  return v;
-}
-
-double Communicator::min(double v) const {
-#ifdef DOMEL_HAVE_MPI
-  if (impl_) check(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MIN, impl_->comm), "MPI_Allreduce");
-#endif
-  return v;
-}
-
 std::vector<std::vector<char>> Communicator::all_to_all(const std::vector<std::vector<char>>& send) const {
   if (send.size() != static_cast<std::size_t>(size_))
     throw std::invalid_argument("Communicator::all_to_all: one buffer per rank expected");
@@ -114,12 +100,6 @@ std::vector<std::vector<char>> Communicator::all_to_all(const std::vector<std::v
 
 std::vector<std::vector<char>> Communicator::all_gather(const std::vector<char>& mine) const {
   return all_to_all(std::vector<std::vector<char>>(static_cast<std::size_t>(size_), mine));
-}
-
-void Communicator::barrier() const {
-#ifdef DOMEL_HAVE_MPI
-  if (impl_) check(MPI_Barrier(impl_->comm), "MPI_Barrier");
-#endif
 }
 
 MpiSession::MpiSession(int* argc, char*** argv, bool use) {

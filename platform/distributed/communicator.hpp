@@ -28,13 +28,10 @@ class Communicator {
   /// Element-wise sums over the ranks, in place. Integers: exact, so the
   /// result does not depend on how the values are spread over the ranks.
   void sum(std::vector<std::uint64_t>& v) const;
-  double max(double v) const;
-  double min(double v) const;
   /// send[r] goes to rank r; returns what each rank sent here, by rank.
   std::vector<std::vector<char>> all_to_all(const std::vector<std::vector<char>>& send) const;
   /// Every rank's bytes, on every rank, by rank.
   std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) const;
-  void barrier() const;
 
  private:
   struct Impl;

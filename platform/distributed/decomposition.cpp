@@ -32,8 +32,8 @@ double Region::distance(const double p[3]) const {
 Decomposition::Decomposition() {
   Node root;
   for (int a = 0; a < 3; ++a) {
-    root.region.lo[a] = root.extent.lo[a] = -kInf;
-    root.region.hi[a] = root.extent.hi[a] = kInf;
+    root.region.lo[a] = -kInf;
+    root.region.hi[a] = kInf;
   }
   nodes_.push_back(root);
   leaf_.push_back(0);
@@ -48,22 +48,23 @@ Decomposition Decomposition::bisect(const Region& extent, int parts, const doubl
       throw std::invalid_argument("Decomposition::bisect: the extent must be a finite box");
   Decomposition d;
   d.nodes_[0].count = parts;
-  d.nodes_[0].extent = extent;
+  // per node, its region clipped to the extent: where its histograms live
+  std::vector<Region> span{extent};
   std::vector<std::size_t> at(n, 0);  // each point's node
   std::vector<std::size_t> open;
   if (parts > 1) open.push_back(0);
   const double* pos[3] = {x, y, z};
   constexpr int B = kBins;
   while (!open.empty()) {
-    // slot of each open node, and its axis: the extent's longest
+    // slot of each open node, and its axis: its span's longest
     std::vector<long> slot(d.nodes_.size(), -1);
     for (std::size_t s = 0; s < open.size(); ++s) {
-      Node& nd = d.nodes_[open[s]];
       slot[open[s]] = static_cast<long>(s);
+      const Region& sp = span[open[s]];
       int axis = 0;
       for (int a = 1; a < 3; ++a)
-        if (nd.extent.hi[a] - nd.extent.lo[a] > nd.extent.hi[axis] - nd.extent.lo[axis]) axis = a;
-      nd.axis = axis;
+        if (sp.hi[a] - sp.lo[a] > sp.hi[axis] - sp.lo[axis]) axis = a;
+      d.nodes_[open[s]].axis = axis;
     }
     // pass 1: coarse histograms of every open node, summed over the ranks
     std::vector<std::uint64_t> hist(open.size() * B, 0);
@@ -72,7 +73,7 @@ Decomposition Decomposition::bisect(const Region& extent, int parts, const doubl
       if (s < 0) continue;
       const Node& nd = d.nodes_[at[k]];
       hist[static_cast<std::size_t>(s) * B +
-           static_cast<std::size_t>(bin_of(pos[nd.axis][k], nd.extent.lo[nd.axis], nd.extent.hi[nd.axis], B))] +=
+           static_cast<std::size_t>(bin_of(pos[nd.axis][k], span[at[k]].lo[nd.axis], span[at[k]].hi[nd.axis], B))] +=
           cost[k];
     }
     comm.sum(hist);
@@ -101,7 +102,7 @@ Decomposition Decomposition::bisect(const Region& extent, int parts, const doubl
       const long s = slot[at[k]];
       if (s < 0) continue;
       const Node& nd = d.nodes_[at[k]];
-      const double lo = nd.extent.lo[nd.axis], hi = nd.extent.hi[nd.axis];
+      const double lo = span[at[k]].lo[nd.axis], hi = span[at[k]].hi[nd.axis];
       const double v = pos[nd.axis][k];
       const int cb = coarse[static_cast<std::size_t>(s)];
       if (bin_of(v, lo, hi, B) != cb) continue;
@@ -113,7 +114,7 @@ Decomposition Decomposition::bisect(const Region& extent, int parts, const doubl
     for (std::size_t s = 0; s < open.size(); ++s) {
       const std::size_t id = open[s];
       const int axis = d.nodes_[id].axis;
-      const double lo = d.nodes_[id].extent.lo[axis], hi = d.nodes_[id].extent.hi[axis];
+      const double lo = span[id].lo[axis], hi = span[id].hi[axis];
       const int count = d.nodes_[id].count;
       double cut;
       if (total[s] == 0) {
@@ -133,13 +134,18 @@ Decomposition Decomposition::bisect(const Region& extent, int parts, const doubl
       l.count = count / 2;
       r.first = l.first + l.count;
       r.count = count - l.count;
-      l.region.hi[axis] = l.extent.hi[axis] = cut;
-      r.region.lo[axis] = r.extent.lo[axis] = cut;
+      l.region.hi[axis] = cut;
+      r.region.lo[axis] = cut;
+      Region ls = span[id], rs = span[id];
+      ls.hi[axis] = cut;
+      rs.lo[axis] = cut;
       d.nodes_[id].cut = cut;
       d.nodes_[id].left = static_cast<int>(d.nodes_.size());
       d.nodes_.push_back(l);
+      span.push_back(ls);
       d.nodes_[id].right = static_cast<int>(d.nodes_.size());
       d.nodes_.push_back(r);
+      span.push_back(rs);
       if (l.count > 1) next_open.push_back(static_cast<std::size_t>(d.nodes_[id].left));
       if (r.count > 1) next_open.push_back(static_cast<std::size_t>(d.nodes_[id].right));
     }

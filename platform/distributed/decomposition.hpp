@@ -55,7 +55,6 @@ class Decomposition {
 
   struct Node {
     Region region;  ///< what it owns (outer faces at infinity)
-    Region extent;  ///< region clipped to the extent: where its histograms live
     int first = 0, count = 1;  ///< its parts: [first, first + count)
     int axis = -1;             ///< -1: a leaf
     double cut = 0;            ///< left: p[axis] < cut

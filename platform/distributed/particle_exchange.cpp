@@ -2,9 +2,10 @@
 #include "distributed/particle_exchange.hpp"
 
 #include <cstring>
-#include <type_traits>
+#include <iterator>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace domel::platform {
 
@@ -145,12 +146,12 @@ ExchangeCounts GhostExchange::build(const ParticleStore& owned, ParticleStore& g
     c.received += recv[r].size() / per;
   }
   first_[nr] = ghosts.size();
-  ghosts_ = ghosts.size();
   return c;
 }
 
 void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, const Communicator& comm) const {
-  if (ghosts.size() != ghosts_) throw std::logic_error("GhostExchange::update: the ghosts changed since build()");
+  if (first_.empty() || ghosts.size() != first_.back())
+    throw std::logic_error("GhostExchange::update: no build(), or the ghosts changed since");
   const std::vector<const std::vector<double>*> motion = {&owned.x,  &owned.y,  &owned.z,  &owned.vx, &owned.vy,
                                                           &owned.vz, &owned.wx, &owned.wy, &owned.wz};
   std::vector<std::vector<char>> send(sent_.size());
@@ -165,7 +166,7 @@ void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, co
                                   &ghosts.vz, &ghosts.wx, &ghosts.wy, &ghosts.wz};
   for (std::size_t r = 0; r < recv.size(); ++r) {
     const std::size_t n = first_[r + 1] - first_[r];
-    if (recv[r].size() != n * 9 * sizeof(double))
+    if (recv[r].size() != n * std::size(into) * sizeof(double))
       throw std::runtime_error("GhostExchange::update: rank " + std::to_string(r) + " sent another number of ghosts");
     const auto* p = reinterpret_cast<const double*>(recv[r].data());
     for (std::size_t g = first_[r]; g < first_[r + 1]; ++g)
@@ -174,7 +175,8 @@ void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, co
 }
 
 void GhostExchange::reverse(const ParticleStore& ghosts, ParticleStore& owned, const Communicator& comm) const {
-  if (ghosts.size() != ghosts_) throw std::logic_error("GhostExchange::reverse: the ghosts changed since build()");
+  if (first_.empty() || ghosts.size() != first_.back())
+    throw std::logic_error("GhostExchange::reverse: no build(), or the ghosts changed since");
   const std::vector<const std::vector<double>*> loads = {&ghosts.fx, &ghosts.fy, &ghosts.fz,
                                                          &ghosts.tx, &ghosts.ty, &ghosts.tz};
   const std::size_t nr = sent_.size();
@@ -187,7 +189,7 @@ void GhostExchange::reverse(const ParticleStore& ghosts, ParticleStore& owned, c
   const auto recv = comm.all_to_all(send);
   std::vector<double>* into[6] = {&owned.fx, &owned.fy, &owned.fz, &owned.tx, &owned.ty, &owned.tz};
   for (std::size_t r = 0; r < nr; ++r) {  // in rank order: fixed sums
-    if (recv[r].size() != sent_[r].size() * 6 * sizeof(double))
+    if (recv[r].size() != sent_[r].size() * std::size(into) * sizeof(double))
       throw std::runtime_error("GhostExchange::reverse: rank " + std::to_string(r) + " returned another number of ghosts");
     const auto* p = reinterpret_cast<const double*>(recv[r].data());
     for (std::uint32_t k : sent_[r])

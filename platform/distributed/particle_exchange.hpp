@@ -64,14 +64,11 @@ class GhostExchange {
   void update(const ParticleStore& owned, ParticleStore& ghosts, const Communicator& comm) const;
   /// The ghosts' forces and torques added to their owners'. Collective.
   void reverse(const ParticleStore& ghosts, ParticleStore& owned, const Communicator& comm) const;
-  /// The ghosts this rank holds since the last build().
-  std::size_t ghost_count() const { return ghosts_; }
 
  private:
   std::vector<std::vector<std::uint32_t>> sent_;  ///< per rank: the owned particles it holds as ghosts
   std::vector<std::vector<std::array<double, 3>>> shift_;  ///< per rank: each copy's periodic shift [m]
   std::vector<std::size_t> first_;                ///< per rank: its first ghost here (and the total at the end)
-  std::size_t ghosts_ = 0;
 };
 
 }  // namespace domel::platform
