@@ -138,7 +138,43 @@ void NeighborList::for_each_periodic_pair(std::size_t a_first, std::size_t a_las
   }
 }
 
-void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
+PairHistories NeighborList::live_histories() const {
+  PairHistories h;
+  h.stride = stride_;
+  for (std::size_t k = 0; k < i.size(); ++k) {
+    if (!touching[k]) continue;
+    h.id_i.push_back(built_ids_[i[k]]);
+    h.id_j.push_back(built_ids_[j[k]]);
+    h.values.insert(h.values.end(), history.begin() + static_cast<std::ptrdiff_t>(k * stride_),
+                    history.begin() + static_cast<std::ptrdiff_t>((k + 1) * stride_));
+  }
+  return h;
+}
+
+void NeighborList::adopt_histories(PairHistories h) {
+  // the live rows of a list whose particles [0, m) hold the i ids and
+  // [m, 2m) the j ids, and whose layout no store can match: the next build
+  // finds the rows by ids
+  const std::size_t m = h.size();
+  if (h.id_j.size() != m || h.values.size() != m * stride_ || (m > 0 && h.stride != stride_))
+    throw std::invalid_argument("NeighborList::adopt_histories: " + std::to_string(m) + " pairs with " +
+                                std::to_string(h.id_j.size()) + " partners and " + std::to_string(h.values.size()) +
+                                " history values (" + std::to_string(stride_) + " per pair expected)");
+  built_ids_ = std::move(h.id_i);
+  built_ids_.insert(built_ids_.end(), h.id_j.begin(), h.id_j.end());
+  i.resize(m);
+  j.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    i[k] = static_cast<uint32_t>(k);
+    j[k] = static_cast<uint32_t>(m + k);
+  }
+  touching.assign(m, 1);
+  history = std::move(h.values);
+  near_size_ = m;
+  built_size_ = SIZE_MAX;  // layout_stale() from now on: the next build carries over by ids
+}
+
+void NeighborList::build(const ParticleStore& s, ThreadPool* pool, std::size_t owned) {
   const std::size_t n = s.size();
   // Keep only the live history (pairs in contact, ~1-6 per particle), keyed by
   // (id_i, id_j), moved to the front of the history array. The list's arrays
@@ -176,6 +212,7 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
   // build order; far is appended after the cell loop. The first thread's near
   // entries are written straight into the list's arrays.
   const double h = near_gap();
+  const bool with_ghosts = owned < n;
   struct Part {
     std::vector<uint32_t> i, j, fi, fj;
     std::size_t near = 0, far = 0;  ///< entries of the counting pass
@@ -351,7 +388,9 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool) {
       for_each_pair(first, last, [&](std::size_t a, uint32_t b, bool near) {
         auto& ti = near ? part.i : part.fi;
         auto& tj = near ? part.j : part.fj;
-        if (s.id[a] < s.id[b]) { ti.push_back(static_cast<uint32_t>(a)); tj.push_back(b); }
+        const bool a_leads = s.id[a] < s.id[b];
+        if (with_ghosts && (a_leads ? a : b) >= owned) return;  // the lower id is a ghost: its owner computes it
+        if (a_leads) { ti.push_back(static_cast<uint32_t>(a)); tj.push_back(b); }
         else { ti.push_back(b); tj.push_back(static_cast<uint32_t>(a)); }
       });
     });

@@ -59,6 +59,17 @@ inline double min_image(double d, double L, double inv_L) { return d - L * std::
 class ArchiveWriter;
 class ArchiveReader;
 
+/// Live contact histories keyed by their pairs' ids, as they leave one list
+/// (NeighborList::live_histories) and enter the next build of another
+/// (NeighborList::adopt_histories): what a particle that moves to another
+/// rank takes along, for the pairs it leads (the lower id).
+struct PairHistories {
+  std::uint32_t stride = 0;               ///< history values per pair (the contact model's)
+  std::vector<std::uint64_t> id_i, id_j;  ///< id_i < id_j
+  std::vector<double> values;             ///< stride values per pair, in pair order
+  std::size_t size() const { return id_i.size(); }
+};
+
 class NeighborList {
  public:
   void configure(double skin, uint32_t history_stride) {
@@ -96,7 +107,16 @@ class NeighborList {
   static constexpr double kNearFraction = 0.5;
   /// Build from the store's positions; with a pool of several threads the
   /// scan over particles runs in parallel (the same list as on one thread).
-  void build(const ParticleStore& s, ThreadPool* pool = nullptr);
+  /// With `owned` below the store's size, particles [owned, size) are ghosts
+  /// (copies of other ranks' particles, distributed/): a pair is listed only
+  /// when its lower id is owned here, since the rank owning that particle
+  /// computes the pair (ghost-ghost pairs never).
+  void build(const ParticleStore& s, ThreadPool* pool = nullptr, std::size_t owned = SIZE_MAX);
+  /// The live histories (pairs in contact at the last force evaluation) by ids.
+  PairHistories live_histories() const;
+  /// Replace the live histories the next build() carries over by `h` (by
+  /// ids): after particles moved between ranks with the pairs they lead.
+  void adopt_histories(PairHistories h);
   std::size_t size() const { return i.size(); }
   /// Bytes held (capacity): the contact history, and everything else (the
   /// pair indices, the contact flags, the positions and ids of the last build).

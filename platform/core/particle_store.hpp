@@ -89,6 +89,14 @@ struct ParticleStore {
   /// its cache locality, survives). Returns the number removed.
   std::size_t remove_marked(const std::vector<std::uint8_t>& remove);
 
+  /// Keep particles [0, n) and drop the rest (the ghosts after a rank's own
+  /// particles, distributed/).
+  void truncate(std::size_t n) {
+    if (n >= size()) return;
+    for_each_array([n](auto& v) { v.resize(n); });
+    ++layout_version;
+  }
+
   /// Apply a permutation: new index k holds old particle order[k].
   void permute(const std::vector<std::uint32_t>& order);
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <unordered_map>
 
 namespace domel::platform {
 
@@ -65,10 +66,73 @@ std::uint64_t claim_ids(std::uint64_t count, std::uint64_t& next_id, const Commu
   return first;
 }
 
-ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communicator& comm) {
+namespace {
+/// The rows of each set whose leading particle leaves (destination: its new
+/// rank) go there, all sets in one message; each set becomes its kept rows,
+/// then the received ones by sending rank. A set's rows have the same
+/// stride on every rank (one contact model per subdomain). Returns the
+/// number of rows sent.
+std::size_t migrate_histories(const std::vector<PairHistories*>& sets,
+                              const std::unordered_map<std::uint64_t, std::size_t>& destination,
+                              const Communicator& comm) {
+  // a row: set index, id_i, id_j, then the values (bytes of doubles)
+  const std::size_t nr = static_cast<std::size_t>(comm.size());
+  std::vector<std::vector<char>> send(nr);
+  std::vector<PairHistories> kept(sets.size());
+  std::size_t sent = 0;
+  auto append = [](std::vector<char>& b, const void* p, std::size_t bytes) {
+    const auto* c = static_cast<const char*>(p);
+    b.insert(b.end(), c, c + bytes);
+  };
+  for (std::size_t set = 0; set < sets.size(); ++set) {
+    const PairHistories& h = *sets[set];
+    const std::size_t stride = h.stride;
+    kept[set].stride = h.stride;
+    for (std::size_t k = 0; k < h.size(); ++k) {
+      const auto it = destination.find(h.id_i[k]);
+      const double* v = h.values.data() + k * stride;
+      if (it == destination.end()) {
+        kept[set].id_i.push_back(h.id_i[k]);
+        kept[set].id_j.push_back(h.id_j[k]);
+        kept[set].values.insert(kept[set].values.end(), v, v + stride);
+        continue;
+      }
+      ++sent;
+      std::vector<char>& b = send[it->second];
+      const std::uint64_t head[3] = {set, h.id_i[k], h.id_j[k]};
+      append(b, head, sizeof(head));
+      append(b, v, stride * sizeof(double));
+    }
+  }
+  const auto recv = comm.all_to_all(send);
+  for (const auto& b : recv)
+    for (std::size_t at = 0; at < b.size();) {
+      std::uint64_t head[3];
+      if (b.size() - at < sizeof(head)) throw std::runtime_error("migrate: a truncated contact history arrived");
+      std::memcpy(head, b.data() + at, sizeof(head));
+      at += sizeof(head);
+      if (head[0] >= kept.size()) throw std::runtime_error("migrate: contact histories of an unknown set arrived");
+      PairHistories& into = kept[head[0]];
+      const std::size_t bytes = into.stride * sizeof(double);
+      if (b.size() - at < bytes) throw std::runtime_error("migrate: a truncated contact history arrived");
+      into.id_i.push_back(head[1]);
+      into.id_j.push_back(head[2]);
+      const std::size_t old = into.values.size();
+      into.values.resize(old + into.stride);
+      std::memcpy(into.values.data() + old, b.data() + at, bytes);
+      at += bytes;
+    }
+  for (std::size_t set = 0; set < sets.size(); ++set) *sets[set] = std::move(kept[set]);
+  return sent;
+}
+}  // namespace
+
+ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communicator& comm,
+                       const std::vector<PairHistories*>& histories) {
   const auto nr = static_cast<std::size_t>(comm.size());
   std::vector<std::vector<std::uint32_t>> leaving(nr);
   std::vector<std::uint8_t> remove(s.size(), 0);
+  std::unordered_map<std::uint64_t, std::size_t> destination;  // of the leaving particles' ids
   ExchangeCounts c;
   for (std::size_t k = 0; k < s.size(); ++k) {
     const double p[3] = {s.x[k], s.y[k], s.z[k]};
@@ -78,6 +142,7 @@ ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communica
       throw std::runtime_error("migrate: the decomposition has more parts than the communicator has ranks");
     leaving[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(k));
     remove[k] = 1;
+    if (!histories.empty()) destination.emplace(s.id[k], static_cast<std::size_t>(r));
     ++c.sent;
   }
   std::vector<std::vector<char>> send(nr);
@@ -89,6 +154,7 @@ ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communica
     unpack_particles(s, b);
     c.received += b.size() / per;
   }
+  if (!histories.empty()) c.histories_sent = migrate_histories(histories, destination, comm);
   return c;
 }
 
@@ -104,9 +170,11 @@ std::vector<char> gather_values(const std::vector<const std::vector<double>*>& a
 }
 }  // namespace
 
-ExchangeCounts GhostExchange::build(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d,
-                                    double cutoff, const Communicator& comm, const PeriodicBox& box) {
+ExchangeCounts GhostExchange::build(ParticleStore& s, std::size_t owned, const Decomposition& d, double cutoff,
+                                    const Communicator& comm, const PeriodicBox& box) {
   const auto nr = static_cast<std::size_t>(comm.size());
+  s.truncate(owned);
+  owned = s.size();
   sent_.assign(nr, {});
   shift_.assign(nr, {});
   double period[3], inv[3];
@@ -115,13 +183,13 @@ ExchangeCounts GhostExchange::build(const ParticleStore& owned, ParticleStore& g
     if (box.axis[a] && period[a] < 2.0 * cutoff)
       throw std::invalid_argument("GhostExchange: a periodic axis shorter than twice the ghost cut-off");
   std::vector<std::array<double, 3>> shifts{{0.0, 0.0, 0.0}};
-  for (const auto& s : box.image_shifts()) shifts.push_back({s[0] * period[0], s[1] * period[1], s[2] * period[2]});
+  for (const auto& sh : box.image_shifts()) shifts.push_back({sh[0] * period[0], sh[1] * period[1], sh[2] * period[2]});
   std::vector<int> near;
   ExchangeCounts c;
-  for (std::size_t k = 0; k < owned.size(); ++k)
+  for (std::size_t k = 0; k < owned; ++k)
     for (std::size_t i = 0; i < shifts.size(); ++i) {
       const auto& sh = shifts[i];
-      const double p[3] = {owned.x[k] + sh[0], owned.y[k] + sh[1], owned.z[k] + sh[2]};
+      const double p[3] = {s.x[k] + sh[0], s.y[k] + sh[1], s.z[k] + sh[2]};
       d.parts_within(p, cutoff, near, box);
       for (int r : near)
         if ((r != comm.rank() || i > 0) && static_cast<std::size_t>(r) < nr) {
@@ -131,29 +199,37 @@ ExchangeCounts GhostExchange::build(const ParticleStore& owned, ParticleStore& g
         }
     }
   std::vector<std::vector<char>> send(nr);
-  for (std::size_t r = 0; r < nr; ++r) {
-    send[r] = pack_particles(owned, sent_[r], &shift_[r]);
-  }
-  ghosts = ParticleStore{};
-  if (owned.has_external_force()) ghosts.enable_external_force();
-  ghosts.add_aux(owned.aux.size());
+  for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(s, sent_[r], &shift_[r]);
   const auto recv = comm.all_to_all(send);
-  const std::size_t per = particle_bytes(owned);
+  const std::size_t per = particle_bytes(s);
   first_.assign(nr + 1, 0);
   for (std::size_t r = 0; r < nr; ++r) {
-    first_[r] = ghosts.size();
-    unpack_particles(ghosts, recv[r]);
+    first_[r] = s.size();
+    unpack_particles(s, recv[r]);
     c.received += recv[r].size() / per;
   }
-  first_[nr] = ghosts.size();
+  first_[nr] = s.size();
   return c;
 }
 
-void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, const Communicator& comm) const {
-  if (first_.empty() || ghosts.size() != first_.back())
-    throw std::logic_error("GhostExchange::update: no build(), or the ghosts changed since");
-  const std::vector<const std::vector<double>*> motion = {&owned.x,  &owned.y,  &owned.z,  &owned.vx, &owned.vy,
-                                                          &owned.vz, &owned.wx, &owned.wy, &owned.wz};
+void GhostExchange::check(const ParticleStore& s, const char* what) const {
+  if (first_.empty() || s.size() != first_.back())
+    throw std::logic_error(std::string("GhostExchange::") + what + ": no build(), or the store changed since");
+}
+
+std::size_t GhostExchange::update_bytes() const {
+  std::size_t n = 0;
+  for (const auto& r : sent_) n += r.size();
+  return n * 9 * sizeof(double);
+}
+
+std::size_t GhostExchange::reverse_bytes() const {
+  return first_.empty() ? 0 : (first_.back() - first_.front()) * 6 * sizeof(double);
+}
+
+void GhostExchange::update(ParticleStore& s, const Communicator& comm) const {
+  check(s, "update");
+  const std::vector<const std::vector<double>*> motion = {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz};
   std::vector<std::vector<char>> send(sent_.size());
   for (std::size_t r = 0; r < sent_.size(); ++r) {
     send[r] = gather_values(motion, sent_[r]);
@@ -162,8 +238,7 @@ void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, co
       for (std::size_t a = 0; a < 3; ++a) v[q * motion.size() + a] += shift_[r][q][a];  // images: shifted positions
   }
   const auto recv = comm.all_to_all(send);
-  std::vector<double>* into[9] = {&ghosts.x,  &ghosts.y,  &ghosts.z,  &ghosts.vx, &ghosts.vy,
-                                  &ghosts.vz, &ghosts.wx, &ghosts.wy, &ghosts.wz};
+  std::vector<double>* into[9] = {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz};
   for (std::size_t r = 0; r < recv.size(); ++r) {
     const std::size_t n = first_[r + 1] - first_[r];
     if (recv[r].size() != n * std::size(into) * sizeof(double))
@@ -174,11 +249,9 @@ void GhostExchange::update(const ParticleStore& owned, ParticleStore& ghosts, co
   }
 }
 
-void GhostExchange::reverse(const ParticleStore& ghosts, ParticleStore& owned, const Communicator& comm) const {
-  if (first_.empty() || ghosts.size() != first_.back())
-    throw std::logic_error("GhostExchange::reverse: no build(), or the ghosts changed since");
-  const std::vector<const std::vector<double>*> loads = {&ghosts.fx, &ghosts.fy, &ghosts.fz,
-                                                         &ghosts.tx, &ghosts.ty, &ghosts.tz};
+void GhostExchange::reverse(ParticleStore& s, const Communicator& comm) const {
+  check(s, "reverse");
+  const std::vector<const std::vector<double>*> loads = {&s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz};
   const std::size_t nr = sent_.size();
   std::vector<std::vector<char>> send(nr);
   for (std::size_t r = 0; r < nr; ++r) {
@@ -187,7 +260,7 @@ void GhostExchange::reverse(const ParticleStore& ghosts, ParticleStore& owned, c
     send[r] = gather_values(loads, mine);
   }
   const auto recv = comm.all_to_all(send);
-  std::vector<double>* into[6] = {&owned.fx, &owned.fy, &owned.fz, &owned.tx, &owned.ty, &owned.tz};
+  std::vector<double>* into[6] = {&s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz};
   for (std::size_t r = 0; r < nr; ++r) {  // in rank order: fixed sums
     if (recv[r].size() != sent_[r].size() * std::size(into) * sizeof(double))
       throw std::runtime_error("GhostExchange::reverse: rank " + std::to_string(r) + " returned another number of ghosts");

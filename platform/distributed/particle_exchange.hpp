@@ -35,12 +35,18 @@ std::uint64_t claim_ids(std::uint64_t count, std::uint64_t& next_id, const Commu
 
 struct ExchangeCounts {
   std::size_t sent = 0, received = 0;
+  std::size_t histories_sent = 0;  ///< migrate(): pair histories that went with the particles
 };
 
 /// Send every particle whose owner is another rank there, and append the
 /// ones other ranks send here (by sending rank, each in its store order).
-/// Collective.
-ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communicator& comm);
+/// Each set of `histories` (the live contact histories of s's pair list,
+/// of its wall lists) is keyed by the particle that leads each row (id_i):
+/// a row goes where that particle goes, since its owner computes the
+/// contact; each set then holds this rank's rows (the kept ones, then the
+/// received ones by sending rank). Collective.
+ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communicator& comm,
+                       const std::vector<PairHistories*>& histories = {});
 
 /// The ghosts of a rank and the way back to their owners. build() sends
 /// copies of the owned particles within `cutoff` of other ranks' regions and
@@ -53,22 +59,32 @@ ExchangeCounts migrate(ParticleStore& s, const Decomposition& d, const Communica
 /// owner's own rank when its region reaches the other face, so that pairs
 /// through a face are pairs of plain separations as inside (the box must be
 /// at least twice the cut-off along each periodic axis, as for one process).
+///
+/// The ghosts live in the rank's store after its own particles: [0, owned)
+/// are owned, [owned, size) ghosts.
 class GhostExchange {
  public:
-  /// Replace `ghosts` (layout as `owned`) by this rank's ghosts, by sending
-  /// rank, each in its store order. Collective.
-  ExchangeCounts build(const ParticleStore& owned, ParticleStore& ghosts, const Decomposition& d, double cutoff,
+  /// Replace the ghosts of s (everything from `owned` on) by this rank's
+  /// ghosts now, by sending rank, each in its store order. Collective.
+  ExchangeCounts build(ParticleStore& s, std::size_t owned, const Decomposition& d, double cutoff,
                        const Communicator& comm, const PeriodicBox& box = {});
   /// Positions, velocities and angular velocities of the owners into their
   /// ghosts (same particles as at build()). Collective.
-  void update(const ParticleStore& owned, ParticleStore& ghosts, const Communicator& comm) const;
+  void update(ParticleStore& s, const Communicator& comm) const;
   /// The ghosts' forces and torques added to their owners'. Collective.
-  void reverse(const ParticleStore& ghosts, ParticleStore& owned, const Communicator& comm) const;
+  void reverse(ParticleStore& s, const Communicator& comm) const;
+  /// The owned count at the last build (the first ghost's index).
+  std::size_t owned() const { return first_.empty() ? 0 : first_.front(); }
+  /// Bytes sent to other ranks by one update() and by one reverse().
+  std::size_t update_bytes() const;
+  std::size_t reverse_bytes() const;
 
  private:
+  /// Throws unless s holds the particles of the last build.
+  void check(const ParticleStore& s, const char* what) const;
   std::vector<std::vector<std::uint32_t>> sent_;  ///< per rank: the owned particles it holds as ghosts
   std::vector<std::vector<std::array<double, 3>>> shift_;  ///< per rank: each copy's periodic shift [m]
-  std::vector<std::size_t> first_;                ///< per rank: its first ghost here (and the total at the end)
+  std::vector<std::size_t> first_;                ///< per rank: its first ghost in the store (and the size at the end)
 };
 
 }  // namespace domel::platform

@@ -18,12 +18,38 @@ void WallNeighbors::clear() {
   built = false;
 }
 
-void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active) {
+PairHistories WallNeighbors::live_histories(uint32_t stride) const {
+  PairHistories h;
+  h.stride = stride;
+  for (std::size_t k = 0; k < particle.size(); ++k) {
+    if (!touching[k]) continue;
+    h.id_i.push_back(particle_id[k]);
+    h.id_j.push_back(triangle.empty() ? 0 : triangle[k]);
+    h.values.insert(h.values.end(), history.begin() + static_cast<std::ptrdiff_t>(k * stride),
+                    history.begin() + static_cast<std::ptrdiff_t>((k + 1) * stride));
+  }
+  return h;
+}
+
+void WallNeighbors::adopt_histories(PairHistories h) {
+  // what build() reads of the last list: the live rows' ids, triangles and history
+  const std::size_t m = h.size();
+  particle.assign(m, 0);  // no index of this store: only the ids are looked up
+  particle_id = std::move(h.id_i);
+  triangle.resize(m);
+  for (std::size_t k = 0; k < m; ++k) triangle[k] = static_cast<uint32_t>(h.id_j[k]);
+  touching.assign(m, 1);
+  history = std::move(h.values);
+}
+
+void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active,
+                          std::size_t count) {
   if (!active) {
     clear();
     return;
   }
   const bool is_mesh = w.shape == WallPrimitive::Shape::mesh;
+  const std::size_t n = std::min(count, s.size());
   // live contacts by (particle id, triangle)
   using Key = std::pair<std::uint64_t, uint32_t>;
   struct KeyHash {
@@ -49,7 +75,7 @@ void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double
       grid_reach_ = reach;
     }
     const TriangleMesh& m = *w.mesh;
-    for (std::size_t k = 0; k < s.size(); ++k) {
+    for (std::size_t k = 0; k < n; ++k) {
       if (s.fixed(k)) continue;  // see below
       query_.clear();
       grid_.query(s.x[k], s.y[k], s.z[k], query_);
@@ -74,7 +100,7 @@ void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double
     // floor spans the box, the cylinder stands on it) would otherwise count
     // as contacts "inside" the cylinder's wall, overlapping it by up to 27
     // diameters in the diagnostics. As two fixed particles never interact.
-    for (std::size_t k = 0; k < s.size(); ++k)
+    for (std::size_t k = 0; k < n; ++k)
       if (!s.fixed(k) && w.near(s.x[k], s.y[k], s.z[k], s.radius[k] + skin))
         particle.push_back(static_cast<uint32_t>(k));
   }

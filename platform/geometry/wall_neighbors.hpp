@@ -6,6 +6,7 @@
 // re-ordering by particle id (and triangle).
 #pragma once
 
+#include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
 #include "geometry/triangle_mesh.hpp"
 #include "geometry/wall.hpp"
@@ -22,10 +23,18 @@ class ArchiveReader;
 class WallNeighbors {
  public:
   /// Rebuild the candidates of wall `w` (placed at its current position).
-  /// An inactive wall (`active` false) gets an empty list.
-  void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active = true);
+  /// An inactive wall (`active` false) gets an empty list. Only particles
+  /// [0, count) are candidates (the rank's own, not its ghosts).
+  void build(const ParticleStore& s, const WallPrimitive& w, double skin, uint32_t stride, bool active = true,
+             std::size_t count = SIZE_MAX);
   /// Drop every candidate and its history (a wall that is removed or not yet active).
   void clear();
+  /// The live contacts' histories keyed by particle id (id_i) and triangle
+  /// (id_j; 0 for a primitive), `stride` values each; and the inverse: the
+  /// next build() carries `h` over (particles that moved between ranks took
+  /// their wall contacts along).
+  PairHistories live_histories(uint32_t stride) const;
+  void adopt_histories(PairHistories h);
   /// Bytes held (capacity): the history rows, and everything else.
   std::size_t history_bytes() const { return history.capacity() * sizeof(double); }
   std::size_t bytes_without_history() const {

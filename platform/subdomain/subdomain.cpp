@@ -120,6 +120,37 @@ void Subdomain::wall_load(std::size_t wall, double f[3]) const {
         for (int a = 0; a < 3; ++a) f[a] -= ts.wall_load[3 * w + a];  // the sums are the forces on the particles
 }
 
+void Subdomain::set_rank_exchange(std::unique_ptr<RankExchange> ranks) {
+  synchronize();
+  ranks_ = std::move(ranks);
+  owned_ = store_.size();
+  ghosts_end_ = owned_;
+  nlist_.set_periodic(ranks_ ? PeriodicBox{} : box_);  // distributed: images are ghosts, separations plain
+}
+
+void Subdomain::reset_forces() {
+  const std::size_t n = owned();
+  pool_->for_range(n, [&](std::size_t first, std::size_t last, int) { body_forces_.apply(store_, first, last); });
+  for (auto* f : {&store_.fx, &store_.fy, &store_.fz, &store_.tx, &store_.ty, &store_.tz})
+    std::fill(f->begin() + static_cast<std::ptrdiff_t>(n), f->end(), 0.0);
+}
+
+std::vector<std::uint64_t> Subdomain::rank_costs() const {
+  // the weights of ForcePartition (a list entry 1, a contact 12 more; a wall
+  // entry 1, a wall contact 6 more), per particle that leads the work; every
+  // particle costs at least 1. Particles added since the build (a pour)
+  // count 1.
+  const std::size_t n = owned();
+  std::vector<std::uint64_t> cost(n, 1);
+  if (nlist_.layout_stale(store_)) return cost;
+  for (std::size_t e = 0; e < nlist_.size(); ++e)
+    if (nlist_.i[e] < n) cost[nlist_.i[e]] += 1 + 12 * nlist_.touching[e];
+  for (const WallNeighbors& w : wall_lists_)
+    for (std::size_t e = 0; e < w.particle.size(); ++e)
+      if (w.particle[e] < n) cost[w.particle[e]] += 1 + 6 * w.touching[e];
+  return cost;
+}
+
 void Subdomain::apply_body_forces(std::size_t first, std::size_t last) {
   synchronize();
   body_forces_.apply(store_, first, last);
@@ -143,13 +174,14 @@ void Subdomain::setup() {
   exchange();
   rebuild_lists();
   if (gravity_) gravity_->at(time_, body_forces_.gravity);
-  const std::size_t n = store_.size();
-  pool_->for_range(n, [&](std::size_t first, std::size_t last, int) { body_forces_.apply(store_, first, last); });
+  reset_forces();
   try {
     contact_forces(false);
   } catch (const PluginError& e) {
     rethrow_with_context(e, "the initial force evaluation");
   }
+  if (ranks_) ranks_->reverse(store_);
+  const std::size_t n = owned();
   // Coinciding particles (two lines of a state file with one position)
   // have no contact normal: their forces are NaN, and the first step would
   // blame the time step.
@@ -176,9 +208,26 @@ void Subdomain::setup() {
 
 
 void Subdomain::exchange() {
+  if (ranks_) {
+    // drop the ghosts, share space out by cost, move particles with the
+    // histories of the pairs they lead and of their wall contacts (their new
+    // rank computes those contacts)
+    const uint32_t stride = pipeline_->history_stride();
+    std::vector<PairHistories> h(1 + wall_lists_.size());
+    h[0] = nlist_.live_histories();
+    for (std::size_t w = 0; w < wall_lists_.size(); ++w) h[1 + w] = wall_lists_[w].live_histories(stride);
+    std::vector<PairHistories*> sets;
+    for (auto& set : h) sets.push_back(&set);
+    owned_ = ranks_->migrate(store_, owned_, rank_costs(), sets);
+    nlist_.adopt_histories(std::move(h[0]));
+    for (std::size_t w = 0; w < wall_lists_.size(); ++w)
+      if (wall_lists_[w].built) wall_lists_[w].adopt_histories(std::move(h[1 + w]));
+    ghosts_end_ = owned_;
+    return;
+  }
   // Periodic boundaries: the migration of one process, particles that left
   // through a periodic face re-enter at the other
-  if (nlist_.periodic().any()) nlist_.periodic().wrap(store_);
+  if (box_.any()) box_.wrap(store_);
 }
 
 void Subdomain::rebuild_lists() {
@@ -196,11 +245,19 @@ void Subdomain::rebuild_lists() {
     reordered_size_ = store_.size();
   }
   ++builds_since_reorder_;
-  nlist_.build(store_, pool_.get());
+  if (ranks_) {
+    // the ghosts: every particle that can meet an owned one before the next
+    // build (cut-off: the largest diameter on any rank + the skin)
+    double rmax = 0.0;
+    for (std::size_t k = 0; k < owned_; ++k) rmax = std::max(rmax, store_.radius[k]);
+    ranks_->build_ghosts(store_, owned_, 2.0 * ranks_->max(rmax) + skin_);
+    ghosts_end_ = store_.size();
+  }
+  nlist_.build(store_, pool_.get(), owned());
   far_active_ = false;
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
     const WallPrimitive& wall = walls_now_[w];
-    wall_lists_[w].build(store_, wall, skin_, pipeline_->history_stride(), wall.active(time_));
+    wall_lists_[w].build(store_, wall, skin_, pipeline_->history_stride(), wall.active(time_), owned());
     wall_lists_[w].built_time = wall_time_;
   }
 }
@@ -218,7 +275,7 @@ void Subdomain::update_walls(double t) {
       // removal: contacts open for good
       list.clear();
       if (active) {
-        list.build(store_, wall, skin_, stride, true);
+        list.build(store_, wall, skin_, stride, true, owned());
         list.built_time = t;
       }
     } else if (active && wall.moving &&
@@ -313,7 +370,7 @@ void Subdomain::synchronize() {
 }
 
 void Subdomain::step_deferred() {
-  if (hooks_.empty()) step_fused();
+  if (hooks_.empty() && !ranks_) step_fused();
   else step_in_order();
 }
 
@@ -322,6 +379,13 @@ bool Subdomain::rebuild_due(bool stale) {
   for (const DriftCounts& c : drift_counts_) {
     beyond_skin = beyond_skin || c.beyond_skin != 0.0;
     beyond_near = beyond_near || c.beyond_near != 0.0;
+  }
+  if (ranks_) {
+    // the same decision on every rank: a ghost moves as far as its owner
+    bool flags[2] = {stale || beyond_skin, beyond_near};
+    ranks_->any(flags, 2);
+    beyond_skin = flags[0];
+    beyond_near = flags[1];
   }
   if (stale || walls_force_rebuild_ || beyond_skin) {
     walls_force_rebuild_ = false;
@@ -392,13 +456,17 @@ void Subdomain::run_hooks(Phase phase) {
 
 void Subdomain::step_in_order() {
   synchronize();  // a step left pending before the first hook was added
+  if (ranks_ && store_.size() != ghosts_end_)
+    throw RuntimeError("subdomain '" + name_ + "': particles were added or removed between steps of a distributed "
+                       "run, which is not supported yet (docs/distributed.md)");
   const double dt = dt_, half = 0.5 * dt_;
   const std::size_t nt = static_cast<std::size_t>(threads());
-  // initial_integrate: half kick and drift, displacements since the last build
+  // initial_integrate: half kick and drift of the owned particles,
+  // displacements since the last build
   drift_counts_.assign(nt, DriftCounts{});
   const bool stale = nlist_.layout_stale(store_);
   const KickDrift how{dt, half, 0.0, false, stale ? nullptr : &nlist_, nullptr};
-  pool_->for_range(store_.size(), [&](std::size_t first, std::size_t last, int t) {
+  pool_->for_range(owned(), [&](std::size_t first, std::size_t last, int t) {
     drift_counts_[static_cast<std::size_t>(t)] = kick_drift(store_, first, last, how);
   });
   run_hooks(Phase::initial_integrate);
@@ -408,12 +476,13 @@ void Subdomain::step_in_order() {
     run_hooks(Phase::exchange);
     rebuild_lists();
     run_hooks(Phase::neighbor);
+  } else if (ranks_) {
+    ranks_->update_ghosts(store_);  // ghost_update (a rebuild made fresh ghosts)
   }
   run_hooks(Phase::ghost_update);
   // body_force: after the exchange, so that particles it brought get theirs
   if (gravity_) gravity_->at(time_ + dt, body_forces_.gravity);
-  pool_->for_range(store_.size(),
-                   [&](std::size_t first, std::size_t last, int) { body_forces_.apply(store_, first, last); });
+  reset_forces();
   run_hooks(Phase::body_force);
   try {
     contact_forces(false);
@@ -421,11 +490,12 @@ void Subdomain::step_in_order() {
     rethrow_with_context(e, "the contact forces");
   }
   run_hooks(Phase::contact_force);
+  if (ranks_) ranks_->reverse(store_);
   run_hooks(Phase::reverse_exchange);
   run_hooks(Phase::post_force);
   // final_integrate
   nonfinite_counts_.assign(nt, 0.0);
-  pool_->for_range(store_.size(), [&](std::size_t first, std::size_t last, int t) {
+  pool_->for_range(owned(), [&](std::size_t first, std::size_t last, int t) {
     nonfinite_counts_[static_cast<std::size_t>(t)] = kick_check(store_, first, last, half);
   });
   for (double bad : nonfinite_counts_)
@@ -547,83 +617,6 @@ SubdomainStats Subdomain::stats() const {
   st.wall_contacts = last_wall_contacts_;
   st.max_overlap_ratio = last_max_overlap_ratio_;
   return st;
-}
-
-}  // namespace domel::platform
-
-// ---- checkpoints ----------------------------------------------------------
-
-namespace domel::platform {
-
-void Subdomain::save(ArchiveWriter& w, const std::string& p) {
-  store();  // finishes the last step and counts the contacts
-  store_.save(w, p + "particles/");
-  nlist_.save(w, p + "pairs/");
-  w.put_scalar<std::uint64_t>(p + "walls", wall_lists_.size());
-  for (std::size_t k = 0; k < wall_lists_.size(); ++k) wall_lists_[k].save(w, p + "wall" + std::to_string(k) + "/");
-  partition_.save(w, p + "split/");
-  std::vector<std::uint64_t> pair_contacts;
-  for (const auto& ts : scratch_) pair_contacts.push_back(ts.pair_contacts);
-  w.put(p + "thread_pair_contacts", pair_contacts);
-  w.put(p + "reals", std::vector<double>{time_, dt_, coarse_grain_, skin_, last_max_overlap_ratio_, wall_time_,
-                                         forces_time_});
-  w.put(p + "counters", std::vector<std::uint64_t>{steps_, last_contacts_, last_wall_contacts_, builds_since_reorder_,
-                                                   reordered_size_, far_active_ ? 1u : 0u,
-                                                   walls_force_rebuild_ ? 1u : 0u});
-}
-
-bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
-  synchronize();
-  const auto reals = r.get<double>(p + "reals");
-  const auto counters = r.get<std::uint64_t>(p + "counters");
-  if (reals.size() != 7) r.fail(p + "reals", "holds " + std::to_string(reals.size()) + " values, expected 7");
-  if (counters.size() != 7) r.fail(p + "counters", "holds " + std::to_string(counters.size()) + " values, expected 7");
-  if (reals[1] != dt_)
-    r.fail(p + "reals", "was written with a time step of " + std::to_string(reals[1]) + " s; subdomain '" + name_ +
-                            "' now steps " + std::to_string(dt_) + " s");
-  if (reals[2] != coarse_grain_)
-    r.fail(p + "reals", "was written with coarse_grain " + std::to_string(reals[2]) + "; subdomain '" + name_ +
-                            "' now has " + std::to_string(coarse_grain_));
-  if (reals[3] != skin_) r.fail(p + "reals", "was written with another neighbour-list skin");
-  nlist_.configure(skin_, pipeline_->history_stride());
-  store_.load(r, p + "particles/");
-  nlist_.load(r, p + "pairs/");
-  const std::size_t n = store_.size();
-  for (std::size_t e = 0; e < nlist_.size(); ++e)
-    if (nlist_.i[e] >= n || nlist_.j[e] >= n) r.fail(p + "pairs/i", "names a particle beyond the store");
-  if (r.scalar<std::uint64_t>(p + "walls") != wall_lists_.size())
-    r.fail(p + "walls", "holds " + std::to_string(r.scalar<std::uint64_t>(p + "walls")) + " walls; the scenario has " +
-                            std::to_string(wall_lists_.size()));
-  for (std::size_t k = 0; k < wall_lists_.size(); ++k) {
-    const std::string wp = p + "wall" + std::to_string(k) + "/";
-    wall_lists_[k].load(r, wp);
-    for (uint32_t q : wall_lists_[k].particle)
-      if (q >= n) r.fail(wp + "particle", "names a particle beyond the store");
-    if (wall_lists_[k].history.size() != wall_lists_[k].particle.size() * pipeline_->history_stride())
-      r.fail(wp + "history", "does not hold this contact model's history per candidate");
-  }
-  time_ = reals[0];
-  last_max_overlap_ratio_ = reals[4];
-  wall_time_ = reals[5];
-  forces_time_ = reals[6];
-  steps_ = counters[0];
-  last_contacts_ = counters[1];
-  last_wall_contacts_ = counters[2];
-  builds_since_reorder_ = counters[3];
-  reordered_size_ = counters[4];
-  far_active_ = counters[5] != 0;
-  walls_force_rebuild_ = counters[6] != 0;
-  for (std::size_t w = 0; w < walls_now_.size(); ++w)
-    if (walls_now_[w].moving) walls_now_[w].place((*walls_)[w], wall_time_);
-  if (gravity_) gravity_->at(time_, body_forces_.gravity);  // the loaded forces' time
-  kick_pending_ = false;
-  reduce_pending_ = false;
-  contacts_counted_ = true;
-  const auto pair_contacts = r.get<std::uint64_t>(p + "thread_pair_contacts");
-  if (pair_contacts.size() != scratch_.size()) return false;  // the split is rebuilt at the next evaluation
-  partition_.load(r, p + "split/");
-  for (std::size_t t = 0; t < scratch_.size(); ++t) scratch_[t].pair_contacts = pair_contacts[t];
-  return true;
 }
 
 }  // namespace domel::platform

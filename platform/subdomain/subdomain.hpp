@@ -26,6 +26,7 @@
 #include "subdomain/diagnostics.hpp"
 #include "subdomain/force_partition.hpp"
 #include "subdomain/integrator.hpp"
+#include "subdomain/rank_exchange.hpp"
 #include "subdomain/step_phases.hpp"
 
 #include <cstdint>
@@ -81,8 +82,19 @@ class Subdomain {
   void set_initial_source(std::string source) { initial_source_ = std::move(source); }
   void set_skin(double skin) { skin_ = skin; }
   /// Periodic boundaries (core/neighbor_list.hpp); call before setup().
-  void set_periodic(const PeriodicBox& box) { nlist_.set_periodic(box); }
-  const PeriodicBox& periodic() const { return nlist_.periodic(); }
+  void set_periodic(const PeriodicBox& box) {
+    box_ = box;
+    if (!ranks_) nlist_.set_periodic(box);
+  }
+  const PeriodicBox& periodic() const { return box_; }
+  /// Spread this subdomain over several ranks (rank_exchange.hpp): call
+  /// before setup(), with the store holding this rank's share of the
+  /// particles and no ghosts. Pairs through periodic faces are then pairs
+  /// with ghost images, and each step completes in phase order.
+  void set_rank_exchange(std::unique_ptr<RankExchange> ranks);
+  bool distributed() const { return ranks_ != nullptr; }
+  /// The particles this rank owns: store()[0, owned()); the rest are ghosts.
+  std::size_t owned() const { return ranks_ ? owned_ : store_.size(); }
   /// Re-order the store by spatial cells every `builds` neighbour-list
   /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
   void set_reorder_every(std::size_t builds) { reorder_every_ = builds; }
@@ -192,8 +204,16 @@ class Subdomain {
   /// Rethrow a kernel's failure with the subdomain, step and time.
   [[noreturn]] void rethrow_with_context(const std::exception& e, const char* during) const;
 
-  /// The exchange phase's own work: wrap positions into a periodic box.
+  /// The exchange phase's own work: wrap positions into a periodic box; when
+  /// distributed, migration (with the contact histories) instead.
   void exchange();
+  /// Each owned particle's share of the force evaluation's cost, for the
+  /// ranks' decomposition (the thread balance's estimate: list entries and
+  /// contacts it leads, wall entries and contacts).
+  std::vector<std::uint64_t> rank_costs() const;
+  /// The body-force list on the owned particles, zero on the ghosts (their
+  /// forces are contact forces only, sent home by reverse_exchange).
+  void reset_forces();
   void rebuild_lists();
   /// Move the moving walls to time t; rebuild the list of a wall that became
   /// active or moved more than skin/2 since its build, clear a removed one's.
@@ -268,6 +288,10 @@ class Subdomain {
   bool record_ = false;    ///< fill ContactScratch::records (set_record_contacts)
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::unique_ptr<ThreadPool> pool_;
+  PeriodicBox box_;                     ///< set_periodic()
+  std::unique_ptr<RankExchange> ranks_;  ///< null: all particles on this process
+  std::size_t owned_ = 0;                ///< distributed: the owned particles, ghosts after them
+  std::size_t ghosts_end_ = 0;           ///< distributed: the store's size after the ghosts were built
 };
 
 }  // namespace domel::platform

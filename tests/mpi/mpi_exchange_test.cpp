@@ -71,17 +71,18 @@ std::vector<char> bytes_of(const std::vector<double>& v) {
   return b;
 }
 
-/// The particles of this rank after migration, with their ghosts.
+/// The particles of this rank after migration, then their ghosts.
 struct Distributed {
   Distributed(bool blocks, const dp::PeriodicBox& box = {})
       : comm(dp::Communicator::world()), s(share(comm, blocks)), d(decompose(s, comm)) {
     dp::migrate(s, d, comm);
-    gx.build(s, ghosts, d, kCutoff, comm, box);
+    owned = s.size();
+    gx.build(s, owned, d, kCutoff, comm, box);
   }
   dp::Communicator comm;
-  dp::ParticleStore s;
+  dp::ParticleStore s;  ///< [0, owned) owned, then ghosts
   dp::Decomposition d;
-  dp::ParticleStore ghosts;
+  std::size_t owned = 0;
   dp::GhostExchange gx;
 };
 
@@ -131,12 +132,13 @@ TEST(Mpi, WithTheGhostsEachClosePairIsCompleteOnExactlyOneRank) {
   Distributed run(true);
   const dp::Communicator& comm = run.comm;
   const dp::ParticleStore& s = run.s;
-  const dp::ParticleStore& ghosts = run.ghosts;
+  const auto first_ghost = s.id.begin() + static_cast<std::ptrdiff_t>(run.owned);
+  EXPECT_EQ(run.gx.owned(), run.owned);
   // ghosts are other ranks' particles, each once
-  std::unordered_set<std::uint64_t> owned(s.id.begin(), s.id.end()), here = owned;
-  for (std::uint64_t id : ghosts.id) {
-    EXPECT_EQ(owned.count(id), 0u);
-    EXPECT_TRUE(here.insert(id).second) << "ghost " << id << " twice";
+  std::unordered_set<std::uint64_t> owned(s.id.begin(), first_ghost), here = owned;
+  for (auto g = first_ghost; g != s.id.end(); ++g) {
+    EXPECT_EQ(owned.count(*g), 0u);
+    EXPECT_TRUE(here.insert(*g).second) << "ghost " << *g << " twice";
   }
   // the pairs this rank computes: the owner of the lower id computes a pair
   std::uint64_t computed = 0, missing = 0;
@@ -211,60 +213,48 @@ void ghosts_follow_and_forces_go_home(const dp::PeriodicBox& box) {
   Distributed run(false, box);
   const dp::Communicator& comm = run.comm;
   dp::ParticleStore& s = run.s;
-  dp::ParticleStore& ghosts = run.ghosts;
+  const std::size_t no = run.owned, nall = s.size();
   const dp::GhostExchange& gx = run.gx;
   // the owners move (less than the list's skin would allow) and the ghosts follow
-  for (std::size_t k = 0; k < s.size(); ++k) {
+  for (std::size_t k = 0; k < no; ++k) {
     double p[3];
     moved(s.id[k], p);
     s.x[k] = p[0]; s.y[k] = p[1]; s.z[k] = p[2];
     s.wz[k] = static_cast<double>(s.id[k]);
   }
-  gx.update(s, ghosts, comm);
-  for (std::size_t k = 0; k < ghosts.size(); ++k) {
+  gx.update(s, comm);
+  for (std::size_t k = no; k < nall; ++k) {
     double p[3];
-    moved(ghosts.id[k], p);
+    moved(s.id[k], p);
     // the owner's position, or an image of it a whole period away
     double L[3], inv_L[3];
     box.periods(L, inv_L);
     for (int a = 0; a < 3; ++a) {
-      const double at = a == 0 ? ghosts.x[k] : a == 1 ? ghosts.y[k] : ghosts.z[k];
+      const double at = a == 0 ? s.x[k] : a == 1 ? s.y[k] : s.z[k];
       EXPECT_NEAR(dp::min_image(at - p[a], L[a], inv_L[a]), 0.0, 1e-15);
       if (!box.axis[a]) EXPECT_EQ(at, p[a]);
     }
-    EXPECT_EQ(ghosts.wz[k], static_cast<double>(ghosts.id[k]));
+    EXPECT_EQ(s.wz[k], static_cast<double>(s.id[k]));
   }
   // pair loads on owned + ghosts: the rank owning the lower id computes the
   // pair; each moved by at most sqrt(3) 1e-4, so pairs within this range were
   // within the ghost cut-off when the ghosts were built
   const double rc = kCutoff - 2.0 * std::sqrt(3.0) * 1e-4;
-  for (auto* st : {&s, &ghosts})
-    for (auto* a : {&st->fx, &st->fy, &st->fz, &st->tx, &st->ty, &st->tz}) std::fill(a->begin(), a->end(), 0.0);
-  const std::size_t no = s.size(), nall = no + ghosts.size();
-  auto at = [&](std::size_t k, double p[3]) {
-    const dp::ParticleStore& st = k < no ? s : ghosts;
-    const std::size_t i = k < no ? k : k - no;
-    p[0] = st.x[i]; p[1] = st.y[i]; p[2] = st.z[i];
-  };
+  for (auto* a : {&s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz}) std::fill(a->begin(), a->end(), 0.0);
   auto add = [&](std::size_t k, const double f[3], const double t[3], double sign) {
-    dp::ParticleStore& st = k < no ? s : ghosts;
-    const std::size_t i = k < no ? k : k - no;
-    st.fx[i] += sign * f[0]; st.fy[i] += sign * f[1]; st.fz[i] += sign * f[2];
-    st.tx[i] += t[0]; st.ty[i] += t[1]; st.tz[i] += t[2];
+    s.fx[k] += sign * f[0]; s.fy[k] += sign * f[1]; s.fz[k] += sign * f[2];
+    s.tx[k] += t[0]; s.ty[k] += t[1]; s.tz[k] += t[2];
   };
   for (std::size_t a = 0; a < no; ++a)
     for (std::size_t b = 0; b < nall; ++b) {
-      const std::uint64_t ia = s.id[a], ib = b < no ? s.id[b] : ghosts.id[b - no];
-      if (ia >= ib) continue;  // the lower id is owned here: this rank computes the pair
-      double pa[3], pb[3], f[3], t[3];
-      at(a, pa);
-      at(b, pb);
-      const double sep[3] = {pa[0] - pb[0], pa[1] - pb[1], pa[2] - pb[2]};  // images carry their shift
+      if (s.id[a] >= s.id[b]) continue;  // the lower id is owned here: this rank computes the pair
+      double f[3], t[3];
+      const double sep[3] = {s.x[a] - s.x[b], s.y[a] - s.y[b], s.z[a] - s.z[b]};  // images carry their shift
       if (!load(sep, rc, f, t)) continue;
       add(a, f, t, 1.0);
       add(b, f, t, -1.0);
     }
-  gx.reverse(ghosts, s, comm);
+  gx.reverse(s, comm);
   // one process, same loads
   std::vector<double> fx(kTotal, 0.0), tz(kTotal, 0.0);
   std::vector<std::array<double, 3>> pos(kTotal);
@@ -310,16 +300,4 @@ TEST(Mpi, ThroughPeriodicFacesGhostsAreImagesAndForcesEqualTheNearestImages) {
   box.hi[1] = 0.06;
   box.hi[2] = 0.2;
   ghosts_follow_and_forces_go_home(box);
-}
-
-
-int main(int argc, char** argv) {
-  dp::MpiSession mpi(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  // one report: the other ranks print only failures
-  if (dp::Communicator::world().rank() != 0) {
-    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
-    delete listeners.Release(listeners.default_result_printer());
-  }
-  return RUN_ALL_TESTS();
 }

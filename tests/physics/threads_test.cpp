@@ -16,17 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-json column() {
-  json doc = dt::scenario(dt::hertz_mindlin(), 1e-5, 0.5, 0.5);
-  doc["gravity"] = {0, 0, -9.81};
-  const double d = 0.0028, a = 1.02 * d;
-  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}},
-                   {"max", {10 * a, 10 * a, 40 * a}}, {"open", {"zmax"}}}};
-  json insert = {{"model", "lattice"}, {"diameter", d}, {"spacing", 1.02}, {"jitter", 0.005}};
-  insert["region"] = {{"box", {{"min", {0, 0, 0}}, {"max", {10 * a, 10 * a, 20 * a}}}}};
-  doc["subdomains"][0]["insert"] = json::array({insert});
-  return doc;
-}
+json column() { return dt::lattice_column(0.0028); }
 
 std::unique_ptr<domel::platform::Simulation> settle(int threads, int steps, bool deferred = false) {
   auto sim = dt::build(column());

@@ -58,6 +58,21 @@ inline nlohmann::json linear_spring(double stiffness) {
           {"tangential", {{"model", "linear"}}}};
 }
 
+/// A 10 x 10 x 20 lattice column of diameter d (spacing 1.02 d, jitter
+/// 0.005) settling under gravity in a box 40 layers high, open at the top:
+/// pairs and walls in contact (Hertz-Mindlin, e = 0.5, mu = 0.5, dt 1e-5 s).
+inline nlohmann::json lattice_column(double d) {
+  nlohmann::json doc = scenario(hertz_mindlin(), 1e-5, 0.5, 0.5);
+  doc["gravity"] = {0, 0, -9.81};
+  const double a = 1.02 * d;
+  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}},
+                   {"max", {10 * a, 10 * a, 40 * a}}, {"open", {"zmax"}}}};
+  nlohmann::json insert = {{"model", "lattice"}, {"diameter", d}, {"spacing", 1.02}, {"jitter", 0.005}};
+  insert["region"] = {{"box", {{"min", {0, 0, 0}}, {"max", {10 * a, 10 * a, 20 * a}}}}};
+  doc["subdomains"][0]["insert"] = nlohmann::json::array({insert});
+  return doc;
+}
+
 inline std::unique_ptr<platform::Simulation> build(const nlohmann::json& doc) {
   return platform::load_scenario(doc, "test.json", builtin_registry());
 }

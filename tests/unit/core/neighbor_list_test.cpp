@@ -372,3 +372,83 @@ TEST(NeighborList, PeriodicAxesFindPairsThroughTheFacesAndKeepTheirHistory) {
   nl.set_periodic(box);
   EXPECT_THROW(nl.build(s), RuntimeError);
 }
+
+TEST(NeighborList, LiveHistoriesAdoptedByAnotherListAreCarriedByIds) {
+  // What a particle takes to another rank: the live rows, by ids, adopted
+  // by another list whose store holds the particles in another order (the
+  // receiving rank's); its next build finds each row's pair.
+  ParticleStore s = cloud(400, 13);
+  NeighborList nl;
+  nl.configure(0.0008, 3);
+  nl.build(s);
+  const auto expected = mark_live(nl, s, 3);
+  const PairHistories h = nl.live_histories();
+  ASSERT_EQ(h.size(), expected.size());
+  EXPECT_EQ(h.stride, 3u);
+  std::vector<std::uint32_t> order(s.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>((k * 101) % order.size());
+  s.permute(order);
+  NeighborList other;
+  other.configure(0.0008, 3);
+  other.adopt_histories(h);
+  other.build(s);
+  std::size_t carried = 0;
+  for (std::size_t k = 0; k < other.size(); ++k) {
+    const auto it = expected.find({s.id[other.i[k]], s.id[other.j[k]]});
+    if (it == expected.end()) {
+      EXPECT_EQ(other.touching[k], 0);
+      continue;
+    }
+    ++carried;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(other.history[k * 3 + c], it->second + c);
+  }
+  EXPECT_EQ(carried, expected.size());
+  PairHistories wrong = h;
+  wrong.values.pop_back();
+  EXPECT_THROW(other.adopt_histories(wrong), std::invalid_argument);
+}
+
+TEST(NeighborList, WithGhostsAPairIsListedOnlyWhereItsLowerIdIsOwned) {
+  // particles [0, owned) owned, the rest ghosts: the list holds exactly the
+  // brute-force pairs whose lower id is an owned particle
+  const ParticleStore s = cloud(600, 17);
+  const std::size_t owned = 350;
+  NeighborList nl;
+  nl.configure(0.0008, 3);
+  nl.build(s, nullptr, owned);
+  std::set<std::uint64_t> owned_ids(s.id.begin(), s.id.begin() + static_cast<std::ptrdiff_t>(owned));
+  std::set<std::pair<std::uint64_t, std::uint64_t>> want, got;
+  for (const auto& p : brute(s, 0.0008))
+    if (owned_ids.count(p.first)) want.insert(p);
+  for (std::size_t k = 0; k < nl.size(); ++k) got.insert({s.id[nl.i[k]], s.id[nl.j[k]]});
+  EXPECT_EQ(got, want);
+  EXPECT_EQ(got.size(), nl.size());
+  EXPECT_GT(want.size(), 100u);
+}
+
+TEST(WallNeighbors, LiveHistoriesAdoptedByAnotherListAreCarriedByIds) {
+  ParticleStore s = cloud(200, 5);
+  WallPrimitive floor;
+  floor.p[2] = 0.01;
+  WallNeighbors wl;
+  wl.build(s, floor, 0.002, 3);
+  ASSERT_FALSE(wl.particle.empty());
+  for (std::size_t k = 0; k < wl.particle.size(); k += 2) {
+    wl.touching[k] = 1;
+    wl.history[k * 3] = static_cast<double>(s.id[wl.particle[k]]);
+  }
+  WallNeighbors other;
+  other.adopt_histories(wl.live_histories(3));
+  other.build(s, floor, 0.002, 3);
+  std::size_t live = 0;
+  for (std::size_t k = 0; k < other.particle.size(); ++k) {
+    EXPECT_EQ(other.touching[k], k % 2 == 0 ? 1 : 0);
+    EXPECT_EQ(other.history[k * 3], k % 2 == 0 ? static_cast<double>(s.id[other.particle[k]]) : 0.0);
+    live += other.touching[k];
+  }
+  EXPECT_GT(live, 0u);
+  // only particles [0, count) are candidates
+  WallNeighbors part;
+  part.build(s, floor, 0.002, 3, true, 50);
+  for (std::uint32_t k : part.particle) EXPECT_LT(k, 50u);
+}

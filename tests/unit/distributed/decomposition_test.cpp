@@ -188,11 +188,10 @@ TEST(ParticleExchange, OneRankKeepsItsParticlesAndHasNoGhosts) {
   const auto m = dp::migrate(s, d, one);
   EXPECT_EQ(m.sent, 0u);
   EXPECT_EQ(s.size(), 4u);
-  dp::ParticleStore ghosts;
   dp::GhostExchange gx;
-  const auto g = gx.build(s, ghosts, d, 0.01, one);
+  const auto g = gx.build(s, s.size(), d, 0.01, one);
   EXPECT_EQ(g.received, 0u);
-  EXPECT_EQ(ghosts.size(), 0u);
+  EXPECT_EQ(s.size(), 4u);  // no ghosts after the owned
 }
 
 TEST(ParticleExchange, OneRankWithAPeriodicAxisHoldsImagesOfItsOwnParticlesNearTheFaces) {
@@ -202,14 +201,15 @@ TEST(ParticleExchange, OneRankWithAPeriodicAxisHoldsImagesOfItsOwnParticlesNearT
   dp::PeriodicBox box;
   box.axis[0] = true;
   box.hi[0] = box.hi[1] = box.hi[2] = 0.1;
-  dp::ParticleStore ghosts;
   dp::GhostExchange gx;
-  gx.build(s, ghosts, dp::Decomposition{}, 0.01, dp::Communicator{}, box);
-  ASSERT_EQ(ghosts.size(), 1u);  // particle 1's image one period along +x
-  EXPECT_EQ(ghosts.id[0], 1u);
-  EXPECT_DOUBLE_EQ(ghosts.x[0], 0.101);
+  gx.build(s, 2, dp::Decomposition{}, 0.01, dp::Communicator{}, box);
+  ASSERT_EQ(s.size(), 3u);  // particle 1's image one period along +x, after the two owned
+  EXPECT_EQ(s.id[2], 1u);
+  EXPECT_DOUBLE_EQ(s.x[2], 0.101);
+  gx.build(s, 2, dp::Decomposition{}, 0.01, dp::Communicator{}, box);
+  EXPECT_EQ(s.size(), 3u);  // a rebuild replaces the ghosts
   box.hi[0] = 0.015;  // shorter than twice the cut-off: images would not be unique
-  EXPECT_THROW(gx.build(s, ghosts, dp::Decomposition{}, 0.01, dp::Communicator{}, box), std::invalid_argument);
+  EXPECT_THROW(gx.build(s, 2, dp::Decomposition{}, 0.01, dp::Communicator{}, box), std::invalid_argument);
 }
 
 TEST(ParticleExchange, OneRankClaimsIdsInSequence) {

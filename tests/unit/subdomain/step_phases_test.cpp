@@ -28,17 +28,7 @@ namespace {
 constexpr double kD = 0.0028;
 
 /// A 10 x 10 x 20 lattice column settling in an open box (pairs and walls in contact).
-json column() {
-  json doc = dt::scenario(dt::hertz_mindlin(), 1e-5, 0.5, 0.5);
-  doc["gravity"] = {0, 0, -9.81};
-  const double a = 1.02 * kD;
-  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}},
-                   {"max", {10 * a, 10 * a, 40 * a}}, {"open", {"zmax"}}}};
-  json insert = {{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.02}, {"jitter", 0.005}};
-  insert["region"] = {{"box", {{"min", {0, 0, 0}}, {"max", {10 * a, 10 * a, 20 * a}}}}};
-  doc["subdomains"][0]["insert"] = json::array({insert});
-  return doc;
-}
+json column() { return dt::lattice_column(kD); }
 
 /// One free particle, no walls.
 json single(double gz) {

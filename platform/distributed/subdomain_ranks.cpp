@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+#include "distributed/subdomain_ranks.hpp"
+
+#include "subdomain/subdomain.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+namespace domel::platform {
+
+SubdomainRanks::SubdomainRanks(Communicator comm, const PeriodicBox& box) : comm_(std::move(comm)), box_(box) {}
+
+void SubdomainRanks::any(bool* flags, std::size_t n) {
+  if (comm_.size() == 1) return;
+  std::vector<std::uint64_t> v(flags, flags + n);
+  comm_.sum(v);
+  for (std::size_t k = 0; k < n; ++k) flags[k] = v[k] != 0;
+}
+
+double SubdomainRanks::max(double x) {
+  if (comm_.size() == 1) return x;
+  std::vector<char> mine(sizeof(double));
+  std::memcpy(mine.data(), &x, sizeof(double));
+  double out = x;
+  for (const auto& b : comm_.all_gather(mine)) {
+    double v = 0.0;
+    std::memcpy(&v, b.data(), sizeof(double));
+    out = std::max(out, v);
+  }
+  return out;
+}
+
+Region SubdomainRanks::extent(const ParticleStore& s, std::size_t owned) const {
+  // lo and -hi per axis, gathered: the smallest of each over the ranks
+  std::vector<double> bounds(6, std::numeric_limits<double>::max());
+  for (std::size_t k = 0; k < owned; ++k) {
+    const double p[3] = {s.x[k], s.y[k], s.z[k]};
+    for (int a = 0; a < 3; ++a) {
+      bounds[static_cast<std::size_t>(a)] = std::min(bounds[static_cast<std::size_t>(a)], p[a]);
+      bounds[static_cast<std::size_t>(3 + a)] = std::min(bounds[static_cast<std::size_t>(3 + a)], -p[a]);
+    }
+  }
+  std::vector<char> mine(bounds.size() * sizeof(double));
+  std::memcpy(mine.data(), bounds.data(), mine.size());
+  for (const auto& b : comm_.all_gather(mine))
+    for (std::size_t i = 0; i < bounds.size(); ++i) {
+      double v = 0.0;
+      std::memcpy(&v, b.data() + i * sizeof(double), sizeof(double));
+      bounds[i] = std::min(bounds[i], v);
+    }
+  Region r{};
+  for (int a = 0; a < 3; ++a) {
+    const auto i = static_cast<std::size_t>(a);
+    r.lo[a] = box_.axis[a] ? box_.lo[a] : bounds[i];
+    r.hi[a] = box_.axis[a] ? box_.hi[a] : -bounds[3 + i];
+    if (!(r.lo[a] <= r.hi[a])) r.lo[a] = r.hi[a] = 0.0;  // no particles anywhere
+  }
+  return r;
+}
+
+std::size_t SubdomainRanks::migrate(ParticleStore& s, std::size_t owned, const std::vector<std::uint64_t>& cost,
+                                    const std::vector<PairHistories*>& histories) {
+  s.truncate(owned);
+  box_.wrap(s);
+  if (comm_.size() > 1) {
+    d_ = Decomposition::bisect(extent(s, owned), comm_.size(), s.x.data(), s.y.data(), s.z.data(), cost.data(),
+                               s.size(), comm_);
+  }
+  const ExchangeCounts c = platform::migrate(s, d_, comm_, histories);
+  ++traffic_.migrations;
+  traffic_.migrated += c.sent;
+  traffic_.histories_sent += c.histories_sent;
+  return s.size();
+}
+
+void SubdomainRanks::build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) {
+  const ExchangeCounts c = ghosts_.build(s, owned, d_, cutoff, comm_, box_);
+  ++traffic_.ghost_builds;
+  traffic_.ghosts += c.received;
+}
+
+void SubdomainRanks::update_ghosts(ParticleStore& s) {
+  ghosts_.update(s, comm_);
+  ++traffic_.updates;
+  traffic_.update_bytes += ghosts_.update_bytes();
+}
+
+void SubdomainRanks::reverse(ParticleStore& s) {
+  ghosts_.reverse(s, comm_);
+  ++traffic_.reverses;
+  traffic_.reverse_bytes += ghosts_.reverse_bytes();
+}
+
+SubdomainRanks& distribute(Subdomain& sd, const Communicator& comm) {
+  auto ranks = std::make_unique<SubdomainRanks>(comm, sd.periodic());
+  SubdomainRanks& out = *ranks;
+  sd.set_rank_exchange(std::move(ranks));
+  return out;
+}
+
+}  // namespace domel::platform

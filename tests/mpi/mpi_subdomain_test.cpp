@@ -1,0 +1,172 @@
+// SPDX-License-Identifier: MIT
+// A subdomain spread over the ranks (distributed/subdomain_ranks.hpp) steps
+// as the same subdomain on one process does: every rank builds the same
+// scenario, keeps every size-th particle, and after the run each particle it
+// owns is compared, by id, with the one-process run of the same scenario.
+// The two runs add the same contact forces in another order, so they differ
+// by round-off, which the collisions amplify; the tolerance is set from
+// that (see kChaos below). A contact history lost or reset when a particle
+// moves to another rank (or a pair computed twice, or a ghost force not sent
+// home) changes a force by its whole tangential part at once, which is
+// orders of magnitude above it.
+#include "distributed/communicator.hpp"
+#include "distributed/subdomain_ranks.hpp"
+#include "support/fixture.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <unordered_map>
+
+namespace dp = domel::platform;
+namespace dt = domel::test;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kD = 0.002;
+
+/// Dense frictional gas in a box periodic along x, y and z: a 10^3 lattice
+/// at 1.2 d (solid fraction 0.30), e = 0.5, mu = 0.5, Hertz-Mindlin.
+json gas() {
+  json doc = dt::scenario(dt::hertz_mindlin(), 1e-5, 0.5, 0.5);
+  const double L = 12 * kD;
+  json insert = {{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.2}, {"jitter", 0.05}};
+  insert["region"] = {{"box", {{"min", {0, 0, 0}}, {"max", {L, L, L}}}}};
+  doc["subdomains"][0]["insert"] = json::array({insert});
+  doc["subdomains"][0]["periodic"] = {{"x", {0, L}}, {"y", {0, L}}, {"z", {0, L}}};
+  return doc;
+}
+
+/// The lattice column of the fixture, settling between the walls of a box.
+json column() { return dt::lattice_column(kD); }
+
+/// Random velocities (0.5 m/s scale) and spins, from the id: the same on every rank.
+void stir(dp::ParticleStore& s) {
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    std::mt19937_64 rng(s.id[k]);
+    std::normal_distribution<double> g(0.0, 0.3);
+    s.vx[k] = g(rng); s.vy[k] = g(rng); s.vz[k] = g(rng);
+    s.wx[k] = g(rng) / kD; s.wy[k] = g(rng) / kD; s.wz[k] = g(rng) / kD;
+  }
+}
+
+struct Run {
+  std::unique_ptr<dp::Simulation> sim;
+  dp::SubdomainRanks* ranks = nullptr;
+  dp::Subdomain& sd() { return *sim->subdomains[0]; }
+};
+
+/// The scenario set up on this process alone, or spread over the ranks of
+/// `comm` (each rank starts with every size-th particle).
+Run prepared(const json& doc, bool stirred, const dp::Communicator* comm, double nudge = 0.0, int threads = 1) {
+  Run r{dt::build(doc)};
+  dp::Subdomain& sd = r.sd();
+  dp::ParticleStore& s = sd.store();
+  if (stirred) stir(s);
+  for (std::size_t k = 0; k < s.size(); ++k) s.x[k] *= 1.0 + nudge;
+  sd.set_threads(threads);
+  sd.set_skin(0.3 * kD);
+  if (comm) {
+    std::vector<std::uint8_t> other(s.size());
+    for (std::size_t k = 0; k < s.size(); ++k)
+      other[k] = s.id[k] % static_cast<std::uint64_t>(comm->size()) != static_cast<std::uint64_t>(comm->rank());
+    s.remove_marked(other);
+    r.ranks = &dp::distribute(sd, *comm);
+  }
+  sd.setup();
+  return r;
+}
+
+struct Difference {
+  double x = 0, v = 0, w = 0;  ///< largest over the particles [m, m/s, rad/s]
+  std::uint64_t compared = 0;
+};
+
+/// This rank's owned particles against the reference, by id (positions by
+/// the nearest image along periodic axes).
+Difference compare(Run& run, Run& ref) {
+  dp::Subdomain& sd = run.sd();
+  const dp::ParticleStore& s = sd.store();
+  const dp::ParticleStore& r = ref.sd().store();
+  std::unordered_map<std::uint64_t, std::size_t> at;
+  for (std::size_t k = 0; k < r.size(); ++k) at.emplace(r.id[k], k);
+  double L[3], inv[3];
+  sd.periodic().periods(L, inv);
+  Difference d;
+  for (std::size_t k = 0; k < sd.owned(); ++k) {
+    const std::size_t q = at.at(s.id[k]);
+    const double dx[3] = {s.x[k] - r.x[q], s.y[k] - r.y[q], s.z[k] - r.z[q]};
+    for (int a = 0; a < 3; ++a) d.x = std::max(d.x, std::abs(dp::min_image(dx[a], L[a], inv[a])));
+    d.v = std::max({d.v, std::abs(s.vx[k] - r.vx[q]), std::abs(s.vy[k] - r.vy[q]), std::abs(s.vz[k] - r.vz[q])});
+    d.w = std::max({d.w, std::abs(s.wx[k] - r.wx[q]), std::abs(s.wy[k] - r.wy[q]), std::abs(s.wz[k] - r.wz[q])});
+    ++d.compared;
+  }
+  return d;
+}
+
+/// How far round-off alone moves these runs: the largest differences of the
+/// one-process run against itself with every x coordinate moved by a few
+/// units in the last place (kNudge, relative), over the same steps, times
+/// kChaos. The distributed run rounds differently at every step (the forces
+/// summed in another order, the images' positions rounded where the
+/// periodic run rounds their separations) and must stay within that band:
+/// both start at round-off and the collisions amplify them alike, but not
+/// at the same moments, hence the factor.
+constexpr double kNudge = 1e-15;
+constexpr double kChaos = 100.0;
+
+void spread_runs_as_one_process(const json& doc, bool stirred, int steps, int threads = 1) {
+  const dp::Communicator comm = dp::Communicator::world();
+  Run ref = prepared(doc, stirred, nullptr);
+  Run ref2 = prepared(doc, stirred, nullptr, kNudge);
+  Run run = prepared(doc, stirred, &comm, 0.0, threads);
+  for (int k = 0; k < steps; ++k) {
+    ref.sd().step();
+    ref2.sd().step();
+    run.sd().step();
+  }
+  const Difference roundoff = compare(ref2, ref);
+  const Difference d = compare(run, ref);
+  // each particle once over the ranks
+  std::vector<std::uint64_t> n{d.compared};
+  comm.sum(n);
+  EXPECT_EQ(n[0], ref.sd().store().size());
+  // the band: round-off's own spread, times kChaos
+  const double bx = kChaos * roundoff.x, bv = kChaos * roundoff.v, bw = kChaos * roundoff.w;
+  EXPECT_LT(d.x, bx) << "rank " << comm.rank() << ": positions differ by " << d.x << " m (round-off: " << roundoff.x
+                     << " m)";
+  EXPECT_LT(d.v, bv) << "rank " << comm.rank() << ": velocities differ by " << d.v << " m/s (round-off: "
+                     << roundoff.v << " m/s)";
+  EXPECT_LT(d.w, bw) << "rank " << comm.rank() << ": angular velocities differ by " << d.w << " rad/s (round-off: "
+                     << roundoff.w << " rad/s)";
+  // the check has something to check: particles and contact histories crossed ranks
+  const dp::RankTraffic& t = run.ranks->traffic();
+  std::vector<std::uint64_t> moved{t.migrated, t.histories_sent, t.ghosts, ref.sd().neighbor_builds()};
+  comm.sum(moved);
+  if (comm.rank() == 0)
+    std::printf("[ ranks %d x %d threads ] %llu particles and %llu contact histories migrated, %llu ghosts at %llu builds; "
+                "largest difference %.3g m, %.3g m/s (round-off alone: %.3g m, %.3g m/s)\n",
+                comm.size(), threads, static_cast<unsigned long long>(moved[0]), static_cast<unsigned long long>(moved[1]),
+                static_cast<unsigned long long>(moved[2]),
+                static_cast<unsigned long long>(moved[3] / static_cast<std::uint64_t>(comm.size())), d.x, d.v,
+                roundoff.x, roundoff.v);
+  if (comm.size() > 1) {
+    EXPECT_GT(moved[0], 0u);
+    EXPECT_GT(moved[1], 0u);
+  }
+  if (comm.size() > 1 || run.sd().periodic().any()) EXPECT_GT(moved[2], 0u);  // ghosts (on one rank: periodic images)
+}
+
+}  // namespace
+
+TEST(MpiSubdomain, AFrictionalGasInAPeriodicBoxMovesAsOnOneProcess) { spread_runs_as_one_process(gas(), true, 1500); }
+
+TEST(MpiSubdomain, AColumnSettlingBetweenWallsMovesAsOnOneProcess) {
+  spread_runs_as_one_process(column(), false, 1500);
+}
+
+TEST(MpiSubdomain, WithTwoThreadsPerRankTheGasMovesAsOnOneProcess) {
+  spread_runs_as_one_process(gas(), true, 1500, 2);
+}
