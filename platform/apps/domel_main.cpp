@@ -7,6 +7,8 @@
 #include "apps/compare.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "distributed/communicator.hpp"
+#include "distributed/run_ranks.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output_folder.hpp"
 #include "loader/plugin_registry.hpp"
@@ -16,6 +18,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -33,11 +36,19 @@ constexpr int kExitRunFailed = 1;
 constexpr int kExitRefused = 2;
 constexpr int kExitUsage = 64;
 
+/// The ranks of a run under mpirun (one rank otherwise): rank 0 reports, and
+/// the others say only what failed on them.
+dp::Communicator& world() {
+  static dp::Communicator c;
+  return c;
+}
+
 const char* kUsage = R"(usage: domel <command> [options]
 
 commands:
   run FILE [--out DIR] [--overwrite] [--threads N] [--max-steps N] [--time-after N]
       [--restart CHECKPOINT] [--checkpoint-on-signal on|off] [--quiet] [--verbose]
+      (under mpirun -np N: the run spread over N processes, docs/distributed.md)
                       validate and run a scenario; writes particles_*.vtp + particles.pvd
                       (ParaView), probes.csv and summary.json into the output folder.
                       --max-steps stops early; --time-after N also reports the speed of
@@ -145,6 +156,7 @@ void load_default_plugins(dp::PluginRegistry& registry) {
 }
 
 void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
+  if (world().rank() != 0) return;  // every rank read the same scenario: rank 0 says it once
   std::fprintf(stderr, "domel: %s has %zu problem%s:\n", what.c_str(), diags.size(), diags.size() == 1 ? "" : "s");
   for (const auto& d : diags) {
     // a problem in another file (a checkpoint, a state file) names it
@@ -187,6 +199,11 @@ int cmd_run(int argc, char** argv) {
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
   if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
   dp::RunOptions opt;
+  std::unique_ptr<dp::MpiRunRanks> ranks;
+  if (world().size() > 1) {
+    ranks = std::make_unique<dp::MpiRunRanks>(world());
+    opt.ranks = ranks.get();
+  }
   if (auto o = a.option("--out")) opt.output_directory = *o;
   if (auto t = a.option("--threads")) opt.threads = parse_threads(*t);
   if (auto s = a.option("--max-steps")) opt.max_steps = static_cast<std::uint64_t>(parse_count("--max-steps", *s));
@@ -209,14 +226,15 @@ int cmd_run(int argc, char** argv) {
     sim = dp::load_scenario(a.positional[0], registry);
   } catch (const dp::ConfigError& e) {
     print_diagnostics(a.positional[0], e.diagnostics());
-    std::fprintf(stderr, "nothing was run and nothing was written.\n");
+    if (world().rank() == 0) std::fprintf(stderr, "nothing was run and nothing was written.\n");
     return kExitRefused;
   }
   try {
     dp::RunResult result;
     try {
       // an earlier run's files are neither mixed with this run's nor removed unasked
-      dp::io::prepare_output_folder(opt.output_directory.empty() ? sim->output_directory : opt.output_directory,
+      if (world().rank() == 0)
+        dp::io::prepare_output_folder(opt.output_directory.empty() ? sim->output_directory : opt.output_directory,
                                     !opt.restart.empty()   ? dp::io::OutputPolicy::restart
                                     : a.flag("--overwrite") ? dp::io::OutputPolicy::overwrite
                                                             : dp::io::OutputPolicy::fresh);
@@ -224,10 +242,11 @@ int cmd_run(int argc, char** argv) {
       result = sim->run(opt, registry);
     } catch (const dp::ConfigError& e) {
       print_diagnostics(a.positional[0], e.diagnostics());
-      std::fprintf(stderr, "nothing was run.\n");
+      if (world().rank() == 0) std::fprintf(stderr, "nothing was run.\n");
       return kExitRefused;
     }
-    std::printf("%s: %llu steps, %.6g s simulated, %.3g s wall, %.3g particle-steps/s; output in %s\n",
+    if (world().rank() == 0)
+      std::printf("%s: %llu steps, %.6g s simulated, %.3g s wall, %.3g particle-steps/s; output in %s\n",
                 sim->name.c_str(), static_cast<unsigned long long>(result.macro_steps), result.simulated_time,
                 result.wall_seconds, result.particle_steps_per_second, result.output_directory.string().c_str());
     if (result.interrupted_by) {
@@ -240,8 +259,9 @@ int cmd_run(int argc, char** argv) {
       return 128 + result.interrupted_by;  // the shell's convention: 130 for SIGINT, 143 for SIGTERM
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "domel: the run of %s failed: %s\nFiles written before the failure are complete; "
-                         "summary.json was not written.\n", a.positional[0].c_str(), e.what());
+    const std::string where = world().size() > 1 ? " on rank " + std::to_string(world().rank()) : "";
+    std::fprintf(stderr, "domel: the run of %s failed%s: %s\nFiles written before the failure are complete; "
+                         "summary.json was not written.\n", a.positional[0].c_str(), where.c_str(), e.what());
     return kExitRunFailed;
   }
   return 0;
@@ -391,12 +411,33 @@ int cmd_docs(int argc, char** argv) {
   return write_or_print(a, dp::scenario_reference_markdown(registry));
 }
 
+int dispatch(int argc, char** argv);
+
 }  // namespace
 
 int main(int argc, char** argv) {
   auto logger = spdlog::stderr_color_mt("domel");
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("%^[%l]%$ %v");
+  // under mpirun a run is spread over the ranks; everything else is one process
+  const bool spread = argc >= 2 && std::string(argv[1]) == "run" && dp::Communicator::launched_by_mpirun();
+  dp::MpiSession mpi(&argc, &argv, spread);
+  world() = dp::Communicator::world();
+  if (world().rank() != 0) spdlog::set_level(spdlog::level::warn);
+  const int code = dispatch(argc, argv);
+  // a failure on one rank ends every rank (the others may wait in a
+  // collective). A refused scenario is refused alike on every rank, and rank
+  // 0 reports it: the others give it a second to do so before ending the run.
+  if (code != 0 && world().size() > 1) {
+    if (code == kExitRefused && world().rank() != 0) std::this_thread::sleep_for(std::chrono::seconds(1));
+    world().abort(code);
+  }
+  return code;
+}
+
+namespace {
+
+int dispatch(int argc, char** argv) {
   if (argc < 2) {
     std::fputs(kUsage, stderr);
     return kExitUsage;
@@ -430,3 +471,5 @@ int main(int argc, char** argv) {
     return kExitRunFailed;
   }
 }
+
+}  // namespace

@@ -2,6 +2,8 @@
 #include "distributed/communicator.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 #ifdef DOMEL_HAVE_MPI
@@ -100,6 +102,32 @@ std::vector<std::vector<char>> Communicator::all_to_all(const std::vector<std::v
 
 std::vector<std::vector<char>> Communicator::all_gather(const std::vector<char>& mine) const {
   return all_to_all(std::vector<std::vector<char>>(static_cast<std::size_t>(size_), mine));
+}
+
+double Communicator::max(double x) const {
+  if (!impl_) return x;
+  std::vector<char> mine(sizeof(double));
+  std::memcpy(mine.data(), &x, sizeof(double));
+  double out = x;
+  for (const auto& b : all_gather(mine)) {
+    double v = 0.0;
+    std::memcpy(&v, b.data(), sizeof(double));
+    out = std::max(out, v);
+  }
+  return out;
+}
+
+void Communicator::abort(int code) const {
+#ifdef DOMEL_HAVE_MPI
+  if (impl_) MPI_Abort(impl_->comm, code);
+#endif
+  std::exit(code);
+}
+
+bool Communicator::launched_by_mpirun() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"})
+    if (std::getenv(v) != nullptr) return true;
+  return false;
 }
 
 MpiSession::MpiSession(int* argc, char*** argv, bool use) {

@@ -32,6 +32,16 @@ class Communicator {
   std::vector<std::vector<char>> all_to_all(const std::vector<std::vector<char>>& send) const;
   /// Every rank's bytes, on every rank, by rank.
   std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) const;
+  /// The largest x over the ranks.
+  double max(double x) const;
+  /// End every rank of the run now with exit status `code` (MPI_Abort): a
+  /// failure on one rank must not leave the others waiting in a collective.
+  /// Without MPI, exits this process.
+  [[noreturn]] void abort(int code) const;
+  /// Whether this process was started by an MPI launcher (mpirun sets
+  /// OMPI_COMM_WORLD_SIZE, Hydra PMI_SIZE): only then does a program that
+  /// may run alone initialise MPI.
+  static bool launched_by_mpirun();
 
  private:
   struct Impl;

@@ -18,18 +18,7 @@ void SubdomainRanks::any(bool* flags, std::size_t n) {
   for (std::size_t k = 0; k < n; ++k) flags[k] = v[k] != 0;
 }
 
-double SubdomainRanks::max(double x) {
-  if (comm_.size() == 1) return x;
-  std::vector<char> mine(sizeof(double));
-  std::memcpy(mine.data(), &x, sizeof(double));
-  double out = x;
-  for (const auto& b : comm_.all_gather(mine)) {
-    double v = 0.0;
-    std::memcpy(&v, b.data(), sizeof(double));
-    out = std::max(out, v);
-  }
-  return out;
-}
+double SubdomainRanks::max(double x) { return comm_.max(x); }
 
 Region SubdomainRanks::extent(const ParticleStore& s, std::size_t owned) const {
   // lo and -hi per axis, gathered: the smallest of each over the ranks

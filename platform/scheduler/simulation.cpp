@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The run loop: multi-rate stepping of subdomains, outputs and progress.
+// Longer than ~600 lines because run() is one scope on purpose: its output
+// writers, schedules and samplers are locals that its lambdas share, and
+// the order of their calls within a macro step is the run's contract.
 #include "scheduler/simulation.hpp"
 
 #include <sys/resource.h>
@@ -137,12 +140,44 @@ std::string Simulation::why_no_checkpoint() const {
                                 "docs/sdk-guide.md), so this run cannot be checkpointed";
 }
 
+std::vector<Diagnostic> Simulation::not_distributable() const {
+  std::vector<Diagnostic> out;
+  const std::string file = scenario_file.string();
+  auto refuse = [&](const std::string& pointer, const std::string& what) {
+    out.push_back({file, pointer, what + " cannot run spread over MPI ranks yet (docs/distributed.md)",
+                   "run it as one process: domel run without mpirun"});
+  };
+  for (const Pour& p : flow.pours) refuse(p.where, "a pour");
+  if (!flow.deletions.empty()) refuse("/deletion_regions", "a deletion region");
+  if (!flow.planes.empty()) refuse("/output/mass_flow", "a mass-flow plane");
+  if (!grid_setups.empty()) refuse("/output/grids", "a cell grid");
+  if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
+  if (fluid) refuse("/fluid", "a fluid coupling");
+  if (contact_sample.enabled()) refuse("/output", "wall loads or contact output (output.wall_loads, output.contacts)");
+  if (repose_probe) refuse("/output/repose_probe", "the repose probe");
+  if (!region_mass.empty()) refuse("/output/region_mass", "a region-mass probe");
+  if (!servos.empty()) refuse("/walls", "a servo wall");
+  if (checkpoint_interval > 0) refuse("/run/checkpoint_interval", "a checkpoint");
+  return out;
+}
+
 RunResult Simulation::run(const RunOptions& options, const PluginRegistry& registry) {
   RunResult result;
+  // Spread over ranks: every rank runs this function on the same scenario;
+  // rank 0 alone writes files and reports (scheduler/run_ranks.hpp).
+  RunRanks* const ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
+  const bool writer = ranks == nullptr || ranks->rank() == 0;
+  if (ranks) {
+    std::vector<Diagnostic> refused = not_distributable();
+    if (!options.restart.empty())
+      refused.push_back({scenario_file.string(), "", "a restart cannot run spread over MPI ranks yet", ""});
+    if (!refused.empty()) throw ConfigError(refused);
+  }
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
   // A restart is checked against this scenario before anything is written.
-  const std::string why_not = why_no_checkpoint();
+  const std::string why_not =
+      ranks ? std::string("a run spread over MPI ranks cannot write checkpoints yet") : why_no_checkpoint();
   const bool checkpoints_possible = why_not.empty();
   std::optional<OpenedCheckpoint> ck;
   if (!options.restart.empty()) {
@@ -154,8 +189,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (checkpoint_interval > 0 && !checkpoints_possible)
     throw ConfigError({Diagnostic{scenario_file.string(), "/run/checkpoint_interval",
                                   why_not + "; remove run.checkpoint_interval", ""}});
-  std::filesystem::create_directories(out);
-  io::ManifestScope manifest(out);  // lists every file written below (io/output_folder.hpp)
+  std::optional<io::ManifestScope> manifest;  // lists every file written below (io/output_folder.hpp)
+  if (writer) {
+    std::filesystem::create_directories(out);
+    manifest.emplace(out);
+  }
   const int threads_requested =
       options.threads > 0 ? options.threads : (threads > 0 ? threads : default_thread_count());
 
@@ -173,6 +211,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     substeps.push_back(n);
     sd->set_threads(threads_requested);
     sd->set_record_contacts(!ck && contact_sample.enabled());  // the outputs at t = 0 (wall loads, contacts)
+    if (ranks) ranks->distribute(*sd);
     if (!ck) sd->setup();
   }
   if (!ck && contact_sample.enabled()) {
@@ -314,10 +353,43 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       grid_files[g].advance(t);
     }
   };
+  // Spread over ranks, the outputs read each subdomain's particles gathered
+  // on rank 0 in id order (once per output time) and its contact counts
+  // summed over the ranks; otherwise the subdomain itself.
+  std::vector<ParticleStore> gathered(subdomains.size());
+  std::vector<double> gathered_at(subdomains.size(), std::nan(""));
+  auto particles_of = [&](std::size_t k, double t) -> const ParticleStore& {
+    if (!ranks) return subdomains[k]->store();
+    if (!(gathered_at[k] == t)) {
+      gathered[k] = ranks->gather(*subdomains[k]);
+      gathered_at[k] = t;
+    }
+    return gathered[k];
+  };
+  auto stats_of = [&](std::size_t k, double t) {
+    SubdomainStats st = subdomains[k]->stats();
+    if (!ranks) return st;
+    const SubdomainStats local = st;
+    st = kinetic_stats(particles_of(k, t));
+    std::vector<std::uint64_t> counts{local.contacts, local.wall_contacts};
+    ranks->sum(counts);
+    st.contacts = counts[0];
+    st.wall_contacts = counts[1];
+    st.max_overlap_ratio = ranks->max(local.max_overlap_ratio);
+    return st;
+  };
+  auto particles_now = [&]() {
+    std::vector<std::uint64_t> n{0};
+    for (const auto& sd : subdomains) n[0] += sd->owned();
+    if (ranks) ranks->sum(n);
+    return static_cast<std::size_t>(n[0]);
+  };
   std::unique_ptr<io::CsvSeries> probes;
-  if (probe_interval > 0) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
+  const bool probing = probe_interval > 0;  // on every rank: the rows' statistics are collective
+  if (probing && writer) probes = std::make_unique<io::CsvSeries>(out / "probes.csv", columns);
   std::unique_ptr<io::VtkSeriesWriter> vtk;
-  if (vtk_interval > 0) {
+  const bool framing = vtk_interval > 0;
+  if (framing && writer) {
     vtk = std::make_unique<io::VtkSeriesWriter>(out, "particles");
     std::vector<std::string> names;
     for (const Material& m : materials) names.push_back(m.name);
@@ -330,8 +402,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     contact_vtk = std::make_unique<io::ContactSeriesWriter>(out, "contacts");
   auto write_probes = [&](double t) {
     std::vector<double> row = {t};
-    for (const auto& sd : subdomains) {
-      const SubdomainStats st = sd->stats();
+    for (std::size_t k = 0; k < subdomains.size(); ++k) {
+      const SubdomainStats st = stats_of(k, t);
       for (const auto& c : kProbeColumns) row.push_back(c.value(st));
     }
     if (repose_probe)
@@ -348,12 +420,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     flow.append_row(t, row);
     contact_sample.append_values(t, kTimeTolerance * macro, row);
     servos.append_values(t, row);
-    probes->append(row);
+    if (probes) probes->append(row);
   };
   auto write_vtk = [&](double t) {
     std::vector<io::ParticleSet> sets;
     for (std::size_t k = 0; k < subdomains.size(); ++k)
-      sets.push_back({&subdomains[k]->store(), static_cast<int>(k), &subdomains[k]->materials()});
+      sets.push_back({&particles_of(k, t), static_cast<int>(k), &subdomains[k]->materials()});
+    if (!vtk) return;
     vtk->write(t, sets);
     if (wall_vtk) wall_vtk->write(t, walls, scene_lo, scene_hi);
     if (probes) probes->flush();  // probes.csv reaches the frame just written
@@ -364,14 +437,15 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     contact_vtk->write(t, rows ? *rows : std::vector<io::ContactRow>{});
   };
 
-  std::size_t particles = 0;
-  for (const auto& sd : subdomains) particles += sd->store().size();
-  spdlog::info("running '{}': {} particles in {} subdomain(s), {:.6g} s simulated in {} macro steps of {:.4g} s, "
-               "{} thread(s) -> {}",
-               name, particles, subdomains.size(), duration, total_macro, macro, threads_requested, out.string());
+  const std::size_t particles = particles_now();
+  if (writer)
+    spdlog::info("running '{}': {} particles in {} subdomain(s), {:.6g} s simulated in {} macro steps of {:.4g} s, "
+                 "{} thread(s){} -> {}",
+                 name, particles, subdomains.size(), duration, total_macro, macro, threads_requested,
+                 ranks ? " on each of " + std::to_string(ranks->size()) + " ranks" : std::string(), out.string());
 
-  Interval probe_rows(probes ? probe_interval : 0.0, 0.0, macro);
-  Interval vtk_frames(vtk ? vtk_interval : 0.0, 0.0, macro);
+  Interval probe_rows(probing ? probe_interval : 0.0, 0.0, macro);
+  Interval vtk_frames(framing ? vtk_interval : 0.0, 0.0, macro);
   Interval contact_frames(contact_vtk ? contact_interval : 0.0, 0.0, macro);
   Interval checkpoints(checkpoint_interval, checkpoint_interval, macro);
   std::uint64_t m = 0;
@@ -475,7 +549,14 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (m > first_macro && checkpoints_possible &&
         (checkpoints.take(t) || (m == stop && checkpoint_interval > 0)))
       save_checkpoint(m);
-    if (m < stop && (result.interrupted_by = interrupt_requested()) != 0) {
+    result.interrupted_by = m < stop ? interrupt_requested() : 0;
+    if (ranks && m < stop) {
+      // every rank stops at the same macro step: the first signal any rank saw
+      std::vector<std::uint64_t> sig{static_cast<std::uint64_t>(result.interrupted_by)};
+      ranks->sum(sig);
+      if (sig[0] != 0 && result.interrupted_by == 0) result.interrupted_by = SIGTERM;
+    }
+    if (result.interrupted_by != 0) {
       // a signal: the last step is complete; the checkpoint holds it, and
       // probes.csv and the other files end where the checkpoint does
       if (options.checkpoint_on_signal && checkpoints_possible) save_checkpoint(m);
@@ -507,7 +588,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (sample) contact_sample.begin(t_end);
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
       for (int s = 0; s < substeps[k]; ++s) step_subdomain(k, sample && s == substeps[k] - 1);
-      const double ps = static_cast<double>(substeps[k]) * static_cast<double>(subdomains[k]->size());
+      const double ps = static_cast<double>(substeps[k]) * static_cast<double>(subdomains[k]->owned());
       particle_steps += ps;
       if (options.time_after && m >= options.time_after) window_particle_steps += ps;
     }
@@ -518,7 +599,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     const auto now = std::chrono::steady_clock::now();
     const double since = std::chrono::duration<double>(now - last_report).count();
-    if (options.progress && since >= (tty ? 1.0 : 10.0)) {
+    if (writer && options.progress && since >= (tty ? 1.0 : 10.0)) {
       last_report = now;
       const double elapsed = std::chrono::duration<double>(now - start).count();
       const double rate = (m + 1) / elapsed;
@@ -532,7 +613,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (auto& sd : subdomains) sd->synchronize();  // the last step's pending half kick, inside the timing
   const auto end = std::chrono::steady_clock::now();
   const double wall = std::chrono::duration<double>(end - start).count();
-  if (options.progress && tty) std::fprintf(stderr, "\n");
+  if (writer && options.progress && tty) std::fprintf(stderr, "\n");
+  if (ranks) {
+    // every rank's particle-steps (rank 0's progress line counted its own)
+    std::vector<std::uint64_t> ps{static_cast<std::uint64_t>(particle_steps)};
+    ranks->sum(ps);
+    particle_steps = static_cast<double>(ps[0]);
+  }
   if (probes) probes->flush();
   write_grids(static_cast<double>(m) * macro, true);
   for (auto& c : couplings) c->write_grids(static_cast<double>(m) * macro, true);
@@ -556,16 +643,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (ck) summary["restarted_from"] = {{"checkpoint", options.restart.string()}, {"simulated_time_s", ck->loop.time}};
   summary["finished"] = iso_time_now();
   summary["threads"] = threads_requested;
+  summary["ranks"] = ranks ? ranks->size() : 1;
   summary["seed"] = seed;
   summary["steps"] = m;
   summary["simulated_time_s"] = result.simulated_time;
   summary["wall_time_s"] = wall;
-  {
-    std::size_t now = 0;
-    for (const auto& sd : subdomains) now += sd->store().size();
-    summary["particles"] = now;
-    summary["particles_at_start"] = particles;
-  }
+  summary["particles"] = particles_now();
+  summary["particles_at_start"] = particles;
   summary["particle_steps_per_s"] = result.particle_steps_per_second;
   {
     // Peak resident memory of the process (getrusage; Linux reports KiB). The
@@ -579,15 +663,23 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                     {"abi", std::to_string(lib.abi_major) + "." + std::to_string(lib.abi_minor)}});
   summary["plugin_libraries"] = libs;
   summary["models"] = models_used;
-  nlohmann::json files = {{"probes", probes ? "probes.csv" : ""},
-                          {"particles", vtk ? "particles.pvd" : ""},
+  nlohmann::json files = {{"probes", probing ? "probes.csv" : ""},
+                          {"particles", framing ? "particles.pvd" : ""},
                           {"walls", wall_vtk ? "walls.pvd" : ""},
                           {"contacts", contact_vtk ? "contacts.pvd" : ""}};
   nlohmann::json sds = nlohmann::json::array();
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
     const auto& sd = subdomains[k];
-    const SubdomainStats st = sd->stats();
-    const MemoryUse mem = sd->memory_use();
+    const SubdomainStats st = stats_of(k, result.simulated_time);
+    MemoryUse mem = sd->memory_use();
+    if (ranks) {  // over all ranks
+      std::vector<std::uint64_t> b{mem.particles, mem.neighbor_lists, mem.contact_history, mem.threads};
+      ranks->sum(b);
+      mem.particles = static_cast<std::size_t>(b[0]);
+      mem.neighbor_lists = static_cast<std::size_t>(b[1]);
+      mem.contact_history = static_cast<std::size_t>(b[2]);
+      mem.threads = static_cast<std::size_t>(b[3]);
+    }
     sds.push_back({{"name", sd->name()},
                    {"coarse_grain", sd->coarse_grain()},
                    {"particles", st.particles},
@@ -664,7 +756,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
         if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '_';
       std::vector<std::string> names;  // of its materials, by local index
       for (std::size_t g : sd->materials()) names.push_back(materials[g].name);
-      io::write_particle_state(out / f, sd->store(), sd->name(), result.simulated_time, sd->coarse_grain(), names);
+      const ParticleStore& all = particles_of(static_cast<std::size_t>(&sd - subdomains.data()), result.simulated_time);
+      if (writer) io::write_particle_state(out / f, all, sd->name(), result.simulated_time, sd->coarse_grain(), names);
       files["state"][sd->name()] = f;
     }
   }
@@ -672,9 +765,10 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (grid_vtk[g]) files["grids"][grid_setups[g].spec.name] = {{"series", grid_setups[g].spec.name + ".pvd"},
                                                                 {"profile", grid_setups[g].spec.name + "_profile.csv"}};
   summary["outputs"] = files;
-  io::write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
+  if (writer) io::write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
   result.summary = summary;
-  spdlog::info("done: {} steps, {:.6g} s simulated in {:.3g} s wall ({:.3g} particle-steps/s)", m,
+  if (writer)
+    spdlog::info("done: {} steps, {:.6g} s simulated in {:.3g} s wall ({:.3g} particle-steps/s)", m,
                result.simulated_time, wall, result.particle_steps_per_second);
   return result;
 }

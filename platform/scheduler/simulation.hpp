@@ -13,6 +13,7 @@
 #include "loader/plugin_registry.hpp"
 #include "scheduler/contact_sample.hpp"
 #include "scheduler/particle_flow.hpp"
+#include "scheduler/run_ranks.hpp"
 #include "scheduler/schedule.hpp"
 #include "scheduler/servo.hpp"
 #include "subdomain/repose_probe.hpp"
@@ -36,6 +37,9 @@ struct RunOptions {
   std::uint64_t time_after = 0;            ///< benchmarks: also time the steps after this many (warm-up excluded)
   std::filesystem::path restart;           ///< a checkpoint to continue from (docs/checkpoint.md)
   bool checkpoint_on_signal = true;        ///< on SIGINT/SIGTERM (core/interrupt.hpp), write a checkpoint
+  /// A run spread over several processes (scheduler/run_ranks.hpp); null or
+  /// one rank: this process alone.
+  RunRanks* ranks = nullptr;
 };
 
 struct RunResult {
@@ -130,6 +134,10 @@ class Simulation {
 
   /// The macro step and each subdomain's number of sub-steps within it.
   double macro_step() const;
+
+  /// What a run spread over several ranks cannot do yet (docs/distributed.md):
+  /// one diagnostic per part of the scenario, with its JSON pointer.
+  std::vector<Diagnostic> not_distributable() const;
 };
 
 }  // namespace domel::platform

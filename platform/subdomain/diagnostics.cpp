@@ -9,14 +9,15 @@
 
 namespace domel::platform {
 
-SubdomainStats kinetic_stats(const ParticleStore& s) {
+SubdomainStats kinetic_stats(const ParticleStore& s, std::size_t count) {
   SubdomainStats st;
-  st.particles = s.size();
+  const std::size_t n = std::min(count, s.size());
+  st.particles = n;
   double sum_w = 0, sum_slow = 0;
   std::size_t slow = 0;
   std::vector<double> speeds;
-  speeds.reserve(s.size());
-  for (std::size_t k = 0; k < s.size(); ++k) {
+  speeds.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
     if (s.fixed(k)) {
       ++st.fixed;
       continue;

@@ -12,6 +12,7 @@
 #include "geometry/wall_neighbors.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace domel::platform {
@@ -60,8 +61,9 @@ struct InitialOverlaps {
 /// Periodic axes of `box`: pairs through an image count too.
 InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit, const PeriodicBox& box = {});
 
-/// The kinetic part of the statistics (particles, fixed, energies, angular speeds).
-SubdomainStats kinetic_stats(const ParticleStore& s);
+/// The kinetic part of the statistics (particles, fixed, energies, angular
+/// speeds) of particles [0, count).
+SubdomainStats kinetic_stats(const ParticleStore& s, std::size_t count = SIZE_MAX);
 
 /// The bytes of the store and the lists (MemoryUse::threads left 0).
 MemoryUse list_memory(const ParticleStore& s, const NeighborList& list, const std::vector<WallNeighbors>& walls);

@@ -612,7 +612,7 @@ MemoryUse Subdomain::memory_use() const {
 
 SubdomainStats Subdomain::stats() const {
   synchronize_logically_const();
-  SubdomainStats st = kinetic_stats(store_);
+  SubdomainStats st = kinetic_stats(store_, owned());
   st.contacts = last_contacts_;
   st.wall_contacts = last_wall_contacts_;
   st.max_overlap_ratio = last_max_overlap_ratio_;

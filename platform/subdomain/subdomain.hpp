@@ -188,6 +188,7 @@ class Subdomain {
   /// The records of the last force evaluation, one list per thread.
   std::vector<const std::vector<ContactRecord>*> contact_records() const;
   std::size_t neighbor_builds() const { return nlist_.builds(); }
+  /// Of this rank's own particles when distributed (contacts: those it computes).
   SubdomainStats stats() const;
   MemoryUse memory_use() const;
 

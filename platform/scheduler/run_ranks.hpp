@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+// What a run spread over several processes (issue 19) asks of the layer
+// that spreads it (distributed/run_ranks.hpp): every rank builds the same
+// scenario, keeps its share of each subdomain's particles and steps it;
+// rank 0 alone writes the outputs, from the particles gathered to it in id
+// order and from statistics summed over the ranks. Simulation::run() takes
+// one through RunOptions::ranks; without one the run is one process.
+#pragma once
+
+#include "core/particle_store.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace domel::platform {
+
+class Subdomain;
+
+class RunRanks {
+ public:
+  virtual ~RunRanks() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  /// Keep this rank's share of sd's particles and spread sd over the ranks
+  /// (before setup()). Collective.
+  virtual void distribute(Subdomain& sd) = 0;
+  /// The particles every rank owns of sd, on rank 0 in id order (on the
+  /// others: empty). Collective.
+  virtual ParticleStore gather(Subdomain& sd) = 0;
+  /// Element-wise sums over the ranks, in place. Collective.
+  virtual void sum(std::vector<std::uint64_t>& v) = 0;
+  /// The largest x over the ranks. Collective.
+  virtual double max(double x) = 0;
+};
+
+}  // namespace domel::platform

@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""`mpirun -np N domel run` against `domel run` (ctest label mpi).
+
+usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR
+
+1. The settle column for 3000 steps (0.03 s: the column falls and starts to
+   pile; the runs stay within round-off of each other until the pile's
+   collapse turns chaotic, later) on one process and on NP ranks: one
+   summary.json, one probes.csv, one particles.pvd series in the folder;
+   the same particles, steps and probe rows; the kinetic energy of every
+   probe row within 1e-6 relative (round-off through 3000 steps of
+   collisions: measured at most 1e-8 on 2-4 ranks).
+2. A scenario the distributed run cannot do yet (a pour) is refused with
+   its JSON pointer, on every rank, non-zero exit, nothing written.
+3. A failure on rank 0 alone (its output folder holds an earlier run) ends
+   every rank with a non-zero exit and that rank's message, never a hang.
+"""
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+domel, mpiexec, np, scenario, work = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
+mpi = [mpiexec, "-np", str(np), "--oversubscribe"]
+failures = []
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print("FAIL:", what)
+
+
+def run(cmd, timeout=240):
+    try:
+        return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        check(False, "timed out (a hang): " + " ".join(cmd))
+        return None
+
+
+def probes(folder):
+    with open(os.path.join(folder, "probes.csv")) as f:
+        head = f.readline().strip().split(",")
+        return head, [[float(x) for x in line.split(",")] for line in f if line.strip()]
+
+
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+one, many = os.path.join(work, "one"), os.path.join(work, "ranks")
+args = ["run", scenario, "--max-steps", "3000", "--quiet"]
+r1 = run([domel] + args + ["--out", one])
+rn = run(mpi + [domel] + args + ["--out", many])
+check(r1 is not None and r1.returncode == 0, "one process ran")
+check(rn is not None and rn.returncode == 0, f"{np} ranks ran: {rn.stderr if rn else ''}")
+if not failures:
+    s1 = json.load(open(os.path.join(one, "summary.json")))
+    sn = json.load(open(os.path.join(many, "summary.json")))
+    check(sn["ranks"] == np, f"summary.json says {sn['ranks']} ranks")
+    check(sn["particles"] == s1["particles"], "the same particles")
+    check(sn["steps"] == s1["steps"], "the same steps")
+    h1, p1 = probes(one)
+    hn, pn = probes(many)
+    check(h1 == hn and len(p1) == len(pn), "the same probe columns and rows")
+    worst = 0.0
+    for a, b in zip(p1, pn):
+        check(a[0] == b[0] and a[1] == b[1], f"row at t = {a[0]}: time and particle count")
+        for c in (2, 3):  # kinetic energies
+            worst = max(worst, abs(a[c] - b[c]) / max(abs(a[c]), 1e-30))
+    print(f"{np} ranks: largest relative difference of the kinetic energies over {len(p1)} rows: {worst:.3g}")
+    check(worst < 1e-6, f"kinetic energies within 1e-6 (found {worst:.3g})")
+    frames = sorted(f for f in os.listdir(many) if re.match(r"particles_\d+\.vtp$", f))
+    with open(os.path.join(many, frames[-1]), "rb") as f:
+        head = f.read(2000).decode("latin-1")
+    check(f'NumberOfPoints="{s1["particles"]}"' in head, "the last frame holds every particle")
+    check(os.listdir(many).count("summary.json") == 1 and not any("rank" in f for f in os.listdir(many)),
+          "one set of files")
+
+# 2. refused on every rank, nothing written
+with open(scenario) as f:
+    doc = json.load(f)
+doc["subdomains"][0]["pour"] = [{"insert": {"model": "random", "diameter": 0.0028, "volume_fraction": 0.1,
+                                            "region": {"box": {"min": [0, 0, 0.08], "max": [0.02, 0.02, 0.1]}},
+                                            "velocity": [0, 0, -1], "seed": 3},
+                                 "mass_rate": 0.01}]
+poured = os.path.join(work, "poured.json")
+with open(poured, "w") as f:
+    json.dump(doc, f)
+refused_out = os.path.join(work, "refused")
+r = run(mpi + [domel, "run", poured, "--out", refused_out, "--quiet"])
+if r is not None:
+    check(r.returncode != 0, "a pour under mpirun is refused")
+    check("/subdomains" in r.stderr and "MPI ranks" in r.stderr, "the refusal names the pointer: " + r.stderr)
+    check(r.stderr.count("nothing was run") == 1, "rank 0 alone reports it")
+    check(not os.path.exists(os.path.join(refused_out, "summary.json")), "nothing written")
+
+# 3. rank 0 alone fails (its folder holds the earlier run): every rank ends
+r = run(mpi + [domel] + args + ["--out", many], timeout=120)
+if r is not None:
+    check(r.returncode != 0, "a failure on rank 0 ends the run with a non-zero exit")
+    check("earlier run" in r.stderr or "domel_manifest" in r.stderr or "--overwrite" in r.stderr,
+          "rank 0's message: " + r.stderr[:400])
+
+print("passed" if not failures else f"{len(failures)} failure(s)")
+sys.exit(1 if failures else 0)
