@@ -270,4 +270,27 @@ void GhostExchange::reverse(ParticleStore& s, const Communicator& comm) const {
   }
 }
 
+void GhostExchange::reverse_counts(ParticleStore& s, const Communicator& comm) const {
+  check(s, "reverse_counts");
+  const std::size_t nr = sent_.size();
+  std::vector<std::vector<char>> send(nr);
+  for (std::size_t r = 0; r < nr; ++r) {
+    const std::size_t n = first_[r + 1] - first_[r];
+    send[r].resize(n * sizeof(std::uint32_t));
+    std::memcpy(send[r].data(), s.contacts.data() + first_[r], send[r].size());
+    std::fill_n(s.contacts.begin() + static_cast<std::ptrdiff_t>(first_[r]), n, 0u);
+  }
+  const auto recv = comm.all_to_all(send);
+  for (std::size_t r = 0; r < nr; ++r) {
+    if (recv[r].size() != sent_[r].size() * sizeof(std::uint32_t))
+      throw std::runtime_error("GhostExchange::reverse_counts: rank " + std::to_string(r) +
+                               " returned another number of ghosts");
+    for (std::size_t q = 0; q < sent_[r].size(); ++q) {
+      std::uint32_t c = 0;
+      std::memcpy(&c, recv[r].data() + q * sizeof(c), sizeof(c));
+      s.contacts[sent_[r][q]] += c;
+    }
+  }
+}
+
 }  // namespace domel::platform

@@ -73,6 +73,9 @@ class GhostExchange {
   void update(ParticleStore& s, const Communicator& comm) const;
   /// The ghosts' forces and torques added to their owners'. Collective.
   void reverse(ParticleStore& s, const Communicator& comm) const;
+  /// The ghosts' contact counts (ParticleStore::contacts) added to their
+  /// owners', the ghosts' set to 0. Collective.
+  void reverse_counts(ParticleStore& s, const Communicator& comm) const;
   /// The owned count at the last build (the first ghost's index).
   std::size_t owned() const { return first_.empty() ? 0 : first_.front(); }
   /// Bytes sent to other ranks by one update() and by one reverse().

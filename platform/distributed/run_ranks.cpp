@@ -18,21 +18,39 @@ void MpiRunRanks::distribute(Subdomain& sd) {
   std::vector<std::uint8_t> other(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) other[k] = s.id[k] % n != me;
   s.remove_marked(other);
-  platform::distribute(sd, comm_);
+  spread_.emplace_back(&sd, &platform::distribute(sd, comm_));
+}
+
+nlohmann::json MpiRunRanks::traffic(const Subdomain& sd) {
+  RankTraffic t;
+  for (const auto& [s, r] : spread_)
+    if (s == &sd) t = r->traffic();
+  std::vector<std::uint64_t> v{t.migrations, t.migrated,  t.histories_sent, t.ghost_builds, t.ghosts,
+                               t.updates,    t.update_bytes, t.reverses,   t.reverse_bytes};
+  comm_.sum(v);
+  const auto ranks = static_cast<std::uint64_t>(comm_.size());
+  return {{"list_builds", v[0] / ranks},
+          {"particles_migrated", v[1]},
+          {"contact_histories_migrated", v[2]},
+          {"ghosts_per_build", v[3] > 0 ? static_cast<double>(v[4]) / static_cast<double>(v[3] / ranks) : 0.0},
+          {"ghost_update_bytes_per_step", v[5] > 0 ? static_cast<double>(v[6]) / static_cast<double>(v[5] / ranks) : 0.0},
+          {"reverse_bytes_per_step", v[7] > 0 ? static_cast<double>(v[8]) / static_cast<double>(v[7] / ranks) : 0.0}};
 }
 
 
-ParticleStore MpiRunRanks::gather(Subdomain& sd) {
+ParticleStore MpiRunRanks::gather(Subdomain& sd, bool everywhere) {
+  sd.collect_contact_counts();  // the contacts with ghosts counted at their owners too
   const ParticleStore& s = sd.store();
   std::vector<std::uint32_t> mine(sd.owned());
   std::iota(mine.begin(), mine.end(), 0u);
   std::vector<std::vector<char>> send(static_cast<std::size_t>(comm_.size()));
   send[0] = pack_particles(s, mine);
+  if (everywhere) send.assign(send.size(), send[0]);
   const auto recv = comm_.all_to_all(send);
   ParticleStore all;
   if (s.has_external_force()) all.enable_external_force();
   all.add_aux(s.aux.size());
-  if (comm_.rank() != 0) return all;
+  if (comm_.rank() != 0 && !everywhere) return all;
   for (const auto& b : recv) unpack_particles(all, b);
   std::vector<std::uint32_t> order(all.size());
   std::iota(order.begin(), order.end(), 0u);

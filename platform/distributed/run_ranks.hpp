@@ -4,7 +4,11 @@
 #pragma once
 
 #include "distributed/communicator.hpp"
+#include "distributed/subdomain_ranks.hpp"
 #include "scheduler/run_ranks.hpp"
+
+#include <utility>
+#include <vector>
 
 namespace domel::platform {
 
@@ -14,12 +18,15 @@ class MpiRunRanks final : public RunRanks {
   int rank() const override { return comm_.rank(); }
   int size() const override { return comm_.size(); }
   void distribute(Subdomain& sd) override;
-  ParticleStore gather(Subdomain& sd) override;
+  ParticleStore gather(Subdomain& sd, bool everywhere = false) override;
+  std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) override { return comm_.all_gather(mine); }
   void sum(std::vector<std::uint64_t>& v) override { comm_.sum(v); }
   double max(double x) override { return comm_.max(x); }
+  nlohmann::json traffic(const Subdomain& sd) override;
 
  private:
   Communicator comm_;
+  std::vector<std::pair<const Subdomain*, const SubdomainRanks*>> spread_;  ///< distribute()'s exchanges
 };
 
 }  // namespace domel::platform

@@ -42,6 +42,7 @@ class SubdomainRanks final : public RankExchange {
   void build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) override;
   void update_ghosts(ParticleStore& s) override;
   void reverse(ParticleStore& s) override;
+  void reverse_counts(ParticleStore& s) override { ghosts_.reverse_counts(s, comm_); }
 
   const Communicator& communicator() const { return comm_; }
   const Decomposition& decomposition() const { return d_; }

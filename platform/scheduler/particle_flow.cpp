@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 namespace domel::platform {
@@ -98,12 +99,39 @@ double FlowSeries::slope(double t0, double t1) const {
   return den > 0 ? (n * stv - st * sv) / den : std::nan("");
 }
 
+std::vector<std::vector<char>> ParticleFlow::from_every_rank(const std::vector<char>& mine) const {
+  if (!ranks_) return {mine};
+  return ranks_->all_gather(mine);
+}
+
+std::pair<MassUnits, std::uint64_t> ParticleFlow::present(const Subdomain& sd) const {
+  const ParticleStore& s = sd.store();
+  MassUnits mass = 0;
+  for (std::size_t q = 0; q < sd.owned(); ++q) mass += mass_units(s.mass[q]);
+  std::uint64_t n = sd.owned();
+  if (!ranks_) return {mass, n};
+  std::vector<char> mine(sizeof(MassUnits) + sizeof(n));
+  std::memcpy(mine.data(), &mass, sizeof(MassUnits));
+  std::memcpy(mine.data() + sizeof(MassUnits), &n, sizeof(n));
+  mass = 0;
+  n = 0;
+  for (const auto& b : ranks_->all_gather(mine)) {  // integers: exact in any order
+    MassUnits m = 0;
+    std::uint64_t c = 0;
+    std::memcpy(&m, b.data(), sizeof(MassUnits));
+    std::memcpy(&c, b.data() + sizeof(MassUnits), sizeof(c));
+    mass += m;
+    n += c;
+  }
+  return {mass, n};
+}
+
 void ParticleFlow::start(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
   accounts_.assign(subdomains.size(), MassAccount{});
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
-    const ParticleStore& s = subdomains[k]->store();
-    for (std::size_t p = 0; p < s.size(); ++p) accounts_[k].inserted += mass_units(s.mass[p]);
-    accounts_[k].n_inserted = s.size();
+    const auto [mass, n] = present(*subdomains[k]);
+    accounts_[k].inserted += mass;
+    accounts_[k].n_inserted = n;
   }
   for (auto& pl : planes) pl.side.assign(subdomains.size(), {});
   check_planes(subdomains);
@@ -136,30 +164,42 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   const double target = std::min(p.total_mass, p.mass_rate * std::min(elapsed + p.interval, p.end - p.start));
   ++p.events;
   if (p.inserted_mass >= target) return;
-  ParticleStore& st = sd.store();
+  // the particles to keep clear of: all of them, on every rank when spread
+  ParticleStore everywhere;
+  if (ranks_) everywhere = ranks_->gather(sd, true);
+  const ParticleStore& present = ranks_ ? everywhere : sd.store();
   // one seed per event: the pour's seed and the event count mixed with the
   // multiplier and increment of Knuth's MMIX linear congruential generator
   const std::uint64_t seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
   InsertionCandidates c;
   try {
-    c = request_insertion(*p.model, p.region, seed, p.alpha, &st, max_particles, sd.periodic(),
+    c = request_insertion(*p.model, p.region, seed, p.alpha, &present, max_particles, sd.periodic(),
                           p.materials.mixture());
   } catch (const PluginError& e) {
     throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
   }
   // The candidates are independent random draws in random order, so taking
   // them in order until the mass target is met keeps the size distribution.
-  std::size_t taken = 0;
+  // Spread over ranks, every rank takes the same ones and keeps each new
+  // particle by id (the next exchange moves it to its owner).
+  ParticleStore* st = nullptr;  // the store to add to, once a particle is kept here
+  ParticleStore elsewhere;      // a particle kept by another rank: its mass, computed alike
+  std::size_t taken = 0, kept = 0;
   for (std::size_t q = 0; q < c.size() && p.inserted_mass < target; ++q) {
     const std::uint64_t id = next_id++;
-    st.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.materials.density_of(c, q), p.fixed, p.materials.material_of(c, q));
-    const std::size_t k = st.size() - 1;
-    st.vx[k] = p.velocity[0]; st.vy[k] = p.velocity[1]; st.vz[k] = p.velocity[2];
-    p.inserted_mass += st.mass[k];
-    count_inserted(p.subdomain, st.mass[k]);
+    const bool mine = !ranks_ || id % static_cast<std::uint64_t>(ranks_->size()) ==
+                                     static_cast<std::uint64_t>(ranks_->rank());
+    if (mine && !st) st = &sd.particles_to_edit();
+    ParticleStore& into = mine ? *st : elsewhere;
+    into.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.materials.density_of(c, q), p.fixed, p.materials.material_of(c, q));
+    const std::size_t k = into.size() - 1;
+    into.vx[k] = p.velocity[0]; into.vy[k] = p.velocity[1]; into.vz[k] = p.velocity[2];
+    p.inserted_mass += into.mass[k];
+    count_inserted(p.subdomain, into.mass[k]);
     ++taken;
+    kept += mine ? 1 : 0;
   }
-  sd.apply_body_forces(st.size() - taken, st.size());  // their first half kick sees their body forces
+  if (st) sd.apply_body_forces(st->size() - kept, st->size());  // their first half kick sees their body forces
   p.inserted += taken;
   const double deficit = target - p.inserted_mass;
   if (deficit > 0 && p.mass_rate * p.interval > 0) {
@@ -186,11 +226,17 @@ void ParticleFlow::count_removed(std::size_t k, std::uint64_t id, double mass) {
 }
 
 void ParticleFlow::check_planes(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  if (planes.empty()) return;
+  // spread over ranks, every rank watches all particles (gathered in id
+  // order), so the sides and the counts are the same on every rank and a
+  // particle that changed rank between two checks is still followed
+  std::vector<ParticleStore> everywhere(ranks_ ? subdomains.size() : 0);
+  for (std::size_t k = 0; k < everywhere.size(); ++k) everywhere[k] = ranks_->gather(*subdomains[k], true);
   for (auto& pl : planes) {
     if (pl.side.size() != subdomains.size()) pl.side.assign(subdomains.size(), {});
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
       if (pl.subdomain != kAllSubdomains && pl.subdomain != k) continue;
-      const ParticleStore& s = subdomains[k]->store();
+      const ParticleStore& s = ranks_ ? everywhere[k] : subdomains[k]->store();
       auto& side = pl.side[k];
       for (std::size_t q = 0; q < s.size(); ++q) {
         const double d = (s.x[q] - pl.p[0]) * pl.n[0] + (s.y[q] - pl.p[1]) * pl.n[1] + (s.z[q] - pl.p[2]) * pl.n[2];
@@ -207,25 +253,44 @@ void ParticleFlow::check_planes(std::vector<std::unique_ptr<Subdomain>>& subdoma
 }
 
 void ParticleFlow::delete_particles(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  // Each rank removes its own particles and lists them (subdomain, region,
+  // id, mass); then every rank books every rank's lists, in rank order, so
+  // the books are the same everywhere (one process: its own list, in order).
+  struct Removed {
+    std::uint64_t subdomain, region, id;
+    double mass;
+  };
+  std::vector<Removed> removed;
   std::vector<std::uint8_t> mark;
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
-    ParticleStore& s = subdomains[k]->store();
-    mark.assign(s.size(), 0);
+    const ParticleStore& s = subdomains[k]->store();
+    const std::size_t n = subdomains[k]->owned();
+    mark.assign(n, 0);
     bool any = false;
-    for (std::size_t q = 0; q < s.size(); ++q) {
-      for (auto& d : deletions) {
+    for (std::size_t q = 0; q < n; ++q) {
+      for (std::size_t r = 0; r < deletions.size(); ++r) {
+        const DeletionRegion& d = deletions[r];
         if ((d.subdomain != kAllSubdomains && d.subdomain != k) || !region_contains(d.region, s.x[q], s.y[q], s.z[q]))
           continue;
         mark[q] = 1;
         any = true;
-        ++d.removed;
-        d.removed_mass += s.mass[q];
-        count_removed(k, s.id[q], s.mass[q]);
+        removed.push_back({k, r, s.id[q], s.mass[q]});
         break;  // a particle in two regions is counted by the first
       }
     }
-    if (any) s.remove_marked(mark);
+    if (any) subdomains[k]->particles_to_edit().remove_marked(mark);
   }
+  std::vector<char> mine(removed.size() * sizeof(Removed));
+  if (!removed.empty()) std::memcpy(mine.data(), removed.data(), mine.size());
+  for (const auto& b : from_every_rank(mine))
+    for (std::size_t at = 0; at + sizeof(Removed) <= b.size(); at += sizeof(Removed)) {
+      Removed e;
+      std::memcpy(&e, b.data() + at, sizeof(Removed));
+      DeletionRegion& d = deletions.at(e.region);
+      ++d.removed;
+      d.removed_mass += e.mass;
+      count_removed(e.subdomain, e.id, e.mass);
+    }
 }
 
 std::vector<std::string> ParticleFlow::columns() const {
@@ -272,9 +337,8 @@ nlohmann::json ParticleFlow::summary(const std::vector<std::unique_ptr<Subdomain
   nlohmann::json j = nlohmann::json::object();
   nlohmann::json balance = nlohmann::json::object();
   for (std::size_t k = 0; k < subdomains.size() && k < accounts_.size(); ++k) {
-    const ParticleStore& s = subdomains[k]->store();
-    MassUnits present = 0;
-    for (std::size_t q = 0; q < s.size(); ++q) present += mass_units(s.mass[q]);
+    const auto [present_mass, present_count] = present(*subdomains[k]);
+    const MassUnits present = present_mass;
     const MassAccount& a = accounts_[k];
     const MassUnits res = a.inserted - present - a.removed;
     const long long res_units = static_cast<long long>(res);
@@ -285,7 +349,7 @@ nlohmann::json ParticleFlow::summary(const std::vector<std::unique_ptr<Subdomain
                                       {"residual_units_1e-18kg", res_units},
                                       {"exact", res == 0},
                                       {"inserted", a.n_inserted},
-                                      {"present", s.size()},
+                                      {"present", present_count},
                                       {"removed", a.n_removed}};
   }
   j["mass_balance"] = balance;

@@ -17,6 +17,7 @@
 #pragma once
 
 #include "loader/plugin_registry.hpp"
+#include "scheduler/run_ranks.hpp"
 #include "scheduler/schedule.hpp"
 #include "subdomain/subdomain.hpp"
 
@@ -151,6 +152,14 @@ class ParticleFlow {
 
   bool empty() const { return pours.empty() && deletions.empty() && planes.empty() && !external_; }
 
+  /// A run spread over ranks (run_ranks.hpp): every rank keeps the same
+  /// books. A pour's insertion is computed alike on every rank from all
+  /// particles (the same new particles and ids for any rank count), each new
+  /// particle kept by one rank; deletion regions remove each rank's own
+  /// particles and the counts are summed (exactly: integers, 1e-18 kg
+  /// units); the planes watch all particles. Call before start().
+  void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
+
   /// Particles that something else (a coupling between levels) adds to or
   /// removes from subdomain k between steps: they enter the balance like a
   /// pour's or a deletion region's, and a removed one leaves the planes' books.
@@ -192,6 +201,12 @@ class ParticleFlow {
   void pour(Pour& p, double t, Subdomain& sd);
   void delete_particles(std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
+  /// The mass [1e-18 kg] and number of subdomain k's particles, over all ranks.
+  std::pair<MassUnits, std::uint64_t> present(const Subdomain& sd) const;
+  /// Each rank's bytes on every rank (one process: its own).
+  std::vector<std::vector<char>> from_every_rank(const std::vector<char>& mine) const;
+
+  RunRanks* ranks_ = nullptr;
   std::vector<MassAccount> accounts_;
   bool external_ = false;
   Interval checks_;  ///< deletion (and plane) checks, every deletion_interval from deletion_interval on

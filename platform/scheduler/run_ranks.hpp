@@ -9,6 +9,8 @@
 
 #include "core/particle_store.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <vector>
 
@@ -24,13 +26,19 @@ class RunRanks {
   /// Keep this rank's share of sd's particles and spread sd over the ranks
   /// (before setup()). Collective.
   virtual void distribute(Subdomain& sd) = 0;
-  /// The particles every rank owns of sd, on rank 0 in id order (on the
-  /// others: empty). Collective.
-  virtual ParticleStore gather(Subdomain& sd) = 0;
+  /// The particles every rank owns of sd, in id order, on rank 0 (on the
+  /// others: empty), or with `everywhere` on every rank. Collective.
+  virtual ParticleStore gather(Subdomain& sd, bool everywhere = false) = 0;
+  /// Every rank's bytes, on every rank, by rank. Collective.
+  virtual std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) = 0;
   /// Element-wise sums over the ranks, in place. Collective.
   virtual void sum(std::vector<std::uint64_t>& v) = 0;
   /// The largest x over the ranks. Collective.
   virtual double max(double x) = 0;
+  /// What sd's ranks exchanged since the start, summed over the ranks (for
+  /// summary.json: particles and histories migrated, ghosts, bytes).
+  /// Collective.
+  virtual nlohmann::json traffic(const Subdomain& sd) = 0;
 };
 
 }  // namespace domel::platform

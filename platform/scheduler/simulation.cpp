@@ -147,9 +147,6 @@ std::vector<Diagnostic> Simulation::not_distributable() const {
     out.push_back({file, pointer, what + " cannot run spread over MPI ranks yet (docs/distributed.md)",
                    "run it as one process: domel run without mpirun"});
   };
-  for (const Pour& p : flow.pours) refuse(p.where, "a pour");
-  if (!flow.deletions.empty()) refuse("/deletion_regions", "a deletion region");
-  if (!flow.planes.empty()) refuse("/output/mass_flow", "a mass-flow plane");
   if (!grid_setups.empty()) refuse("/output/grids", "a cell grid");
   if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
   if (fluid) refuse("/fluid", "a fluid coupling");
@@ -246,6 +243,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (const auto& c : flow.columns()) columns.push_back(c);
   for (const auto& c : contact_sample.columns()) columns.push_back(c);
   for (const auto& c : servos.columns()) columns.push_back(c);
+  flow.set_ranks(ranks);
   if (!ck) flow.start(subdomains);
 
   // Cell grids: accessible volume from the walls present at the start.
@@ -671,6 +669,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
     const auto& sd = subdomains[k];
     const SubdomainStats st = stats_of(k, result.simulated_time);
+    const nlohmann::json traffic = ranks ? ranks->traffic(*sd) : nlohmann::json();
     MemoryUse mem = sd->memory_use();
     if (ranks) {  // over all ranks
       std::vector<std::uint64_t> b{mem.particles, mem.neighbor_lists, mem.contact_history, mem.threads};
@@ -702,6 +701,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                               {"max_overlap_ratio", st.max_overlap_ratio},
                               {"contacts", st.contacts},
                               {"wall_contacts", st.wall_contacts}}}});
+    if (ranks) sds.back()["ranks_exchange"] = traffic;
   }
   if (repose_probe) {
     nlohmann::json angles = nlohmann::json::object();

@@ -40,6 +40,8 @@ class RankExchange {
   virtual void update_ghosts(ParticleStore& s) = 0;
   /// The ghosts' forces and torques added to their owners'. Collective.
   virtual void reverse(ParticleStore& s) = 0;
+  /// The ghosts' contact counts added to their owners'. Collective.
+  virtual void reverse_counts(ParticleStore& s) = 0;
 };
 
 }  // namespace domel::platform

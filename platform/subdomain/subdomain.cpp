@@ -166,6 +166,23 @@ ParticleStore& Subdomain::store() {
   return store_;
 }
 
+ParticleStore& Subdomain::particles_to_edit() {
+  ParticleStore& s = store();
+  if (ranks_) {
+    s.truncate(owned_);  // the layout changes: the next step rebuilds the lists (on every rank)
+    edited_ = true;
+  }
+  return s;
+}
+
+void Subdomain::collect_contact_counts() {
+  if (!ranks_) return;
+  store();  // counts on owned and ghosts
+  if (contacts_collected_) return;
+  ranks_->reverse_counts(store_);
+  contacts_collected_ = true;
+}
+
 void Subdomain::setup() {
   synchronize();
   const uint32_t stride = pipeline_->history_stride();
@@ -456,9 +473,13 @@ void Subdomain::run_hooks(Phase phase) {
 
 void Subdomain::step_in_order() {
   synchronize();  // a step left pending before the first hook was added
+  if (ranks_ && edited_) {
+    owned_ = ghosts_end_ = store_.size();  // all owned here until the exchange moves them
+    edited_ = false;
+  }
   if (ranks_ && store_.size() != ghosts_end_)
     throw RuntimeError("subdomain '" + name_ + "': particles were added or removed between steps of a distributed "
-                       "run, which is not supported yet (docs/distributed.md)");
+                       "run other than through particles_to_edit()");
   const double dt = dt_, half = 0.5 * dt_;
   const std::size_t nt = static_cast<std::size_t>(threads());
   // initial_integrate: half kick and drift of the owned particles,
@@ -522,6 +543,7 @@ WallSweep Subdomain::wall_sweep() {
 void Subdomain::contact_forces(bool defer_reduce) {
   forces_time_ = time_;
   contacts_counted_ = false;
+  contacts_collected_ = false;
   last_max_overlap_ratio_ = 0;
   for (auto& ts : scratch_) ts.records.clear();
   pair_forces(defer_reduce);

@@ -63,8 +63,13 @@ class Subdomain {
   /// flags, once per force evaluation (no work in the step loop).
   ParticleStore& store();
   const ParticleStore& store() const { return const_cast<Subdomain*>(this)->store(); }  // see synchronize_logically_const
-  /// Particle count (needs no synchronisation).
+  /// Particle count (needs no synchronisation); ghosts included when distributed.
   std::size_t size() const { return store_.size(); }
+  /// Distributed: the owned particles' contact counts made complete (the
+  /// contacts this rank's ghosts saw added to their owners'), as one process
+  /// counts them; then store() returns them until the next force
+  /// evaluation. Collective; nothing to do on one process.
+  void collect_contact_counts();
   /// Finish the last step now (see store()); throws RuntimeError when a
   /// particle became non-finite. Cheap when nothing is pending.
   void synchronize();
@@ -95,6 +100,11 @@ class Subdomain {
   bool distributed() const { return ranks_ != nullptr; }
   /// The particles this rank owns: store()[0, owned()); the rest are ghosts.
   std::size_t owned() const { return ranks_ ? owned_ : store_.size(); }
+  /// The store to add particles to or remove them from between steps (a
+  /// pour, a deletion region, an inflow): store(), without the ghosts when
+  /// distributed (what is added or removed is this rank's own; the next step
+  /// rebuilds the lists on every rank and moves each particle to its owner).
+  ParticleStore& particles_to_edit();
   /// Re-order the store by spatial cells every `builds` neighbour-list
   /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
   void set_reorder_every(std::size_t builds) { reorder_every_ = builds; }
@@ -278,6 +288,7 @@ class Subdomain {
   std::vector<double> nonfinite_counts_;   ///< per thread, of a second half kick
   bool reduce_pending_ = false;
   bool contacts_counted_ = true;  ///< store_.contacts is up to date (count_contacts)
+  bool contacts_collected_ = false;  ///< distributed: and the ghosts' counts were sent home
   bool kick_pending_ = false;  ///< the last step's second half kick is still to do (store())
   double pending_half_ = 0;    ///< its half time step
   double forces_time_ = 0;     ///< time_ at the last force evaluation (wall activity)
@@ -293,6 +304,7 @@ class Subdomain {
   std::unique_ptr<RankExchange> ranks_;  ///< null: all particles on this process
   std::size_t owned_ = 0;                ///< distributed: the owned particles, ghosts after them
   std::size_t ghosts_end_ = 0;           ///< distributed: the store's size after the ghosts were built
+  bool edited_ = false;                  ///< distributed: particles_to_edit() dropped the ghosts
 };
 
 }  // namespace domel::platform

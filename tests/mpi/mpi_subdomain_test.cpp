@@ -129,6 +129,24 @@ void spread_runs_as_one_process(const json& doc, bool stirred, int steps, int th
   }
   const Difference roundoff = compare(ref2, ref);
   const Difference d = compare(run, ref);
+  // each particle's contact count as one process counts it: the contacts a
+  // rank computed with ghosts are counted at their owners too
+  run.sd().collect_contact_counts();
+  {
+    const dp::ParticleStore& s = run.sd().store();
+    const dp::ParticleStore& r = ref.sd().store();
+    std::unordered_map<std::uint64_t, std::uint32_t> contacts;
+    for (std::size_t k = 0; k < r.size(); ++k) contacts.emplace(r.id[k], r.contacts[k]);
+    std::size_t differ = 0, in_contact = 0;
+    for (std::size_t k = 0; k < run.sd().owned(); ++k) {
+      differ += s.contacts[k] != contacts.at(s.id[k]) ? 1 : 0;
+      in_contact += s.contacts[k] > 0 ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0u) << "rank " << comm.rank() << ": particles whose contact count differs from one process";
+    std::vector<std::uint64_t> n{in_contact};
+    comm.sum(n);
+    EXPECT_GT(n[0], 100u);  // the check has something to check
+  }
   // each particle once over the ranks
   std::vector<std::uint64_t> n{d.compared};
   comm.sum(n);

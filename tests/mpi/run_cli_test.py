@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 """`mpirun -np N domel run` against `domel run` (ctest label mpi).
 
-usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR
+usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
 
 1. The settle column for 3000 steps (0.03 s: the column falls and starts to
    pile; the runs stay within round-off of each other until the pile's
@@ -11,10 +11,15 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR
    the same particles, steps and probe rows; the kinetic energy of every
    probe row within 1e-6 relative (round-off through 3000 steps of
    collisions: measured at most 1e-8 on 2-4 ranks).
-2. A scenario the distributed run cannot do yet (a pour) is refused with
-   its JSON pointer, on every rank, non-zero exit, nothing written.
+2. A scenario the distributed run cannot do yet (a cell grid) is refused
+   with its JSON pointer, on every rank, non-zero exit, nothing written.
 3. A failure on rank 0 alone (its output folder holds an earlier run) ends
    every rank with a non-zero exit and that rank's message, never a hang.
+4. With SILO (silo_ci.json; its cell grids removed, its duration cut to
+   0.8 s, the outlet opens at 0.5 s): pour, deletion region and mass-flow
+   plane on NP ranks: the pour inserts the particles one process inserts
+   (count and mass, compared with one process run until the pour is done),
+   the mass balance is exact, and the outlet's and the plane's books agree.
 """
 import json
 import os
@@ -24,6 +29,7 @@ import subprocess
 import sys
 
 domel, mpiexec, np, scenario, work = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
+silo = sys.argv[6] if len(sys.argv) > 6 else None
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
 mpi = [mpiexec, "-np", str(np), "--oversubscribe"]
 failures = []
@@ -83,18 +89,15 @@ if not failures:
 # 2. refused on every rank, nothing written
 with open(scenario) as f:
     doc = json.load(f)
-doc["subdomains"][0]["pour"] = [{"insert": {"model": "random", "diameter": 0.0028, "volume_fraction": 0.1,
-                                            "region": {"box": {"min": [0, 0, 0.08], "max": [0.02, 0.02, 0.1]}},
-                                            "velocity": [0, 0, -1], "seed": 3},
-                                 "mass_rate": 0.01}]
-poured = os.path.join(work, "poured.json")
-with open(poured, "w") as f:
+doc["output"]["grids"] = [{"name": "bed", "min": [0, 0, 0], "max": [0.02856, 0.02856, 0.06], "cells": [2, 2, 4]}]
+gridded = os.path.join(work, "gridded.json")
+with open(gridded, "w") as f:
     json.dump(doc, f)
 refused_out = os.path.join(work, "refused")
-r = run(mpi + [domel, "run", poured, "--out", refused_out, "--quiet"])
+r = run(mpi + [domel, "run", gridded, "--out", refused_out, "--quiet"])
 if r is not None:
-    check(r.returncode != 0, "a pour under mpirun is refused")
-    check("/subdomains" in r.stderr and "MPI ranks" in r.stderr, "the refusal names the pointer: " + r.stderr)
+    check(r.returncode != 0, "a cell grid under mpirun is refused")
+    check("/output/grids" in r.stderr and "MPI ranks" in r.stderr, "the refusal names the pointer: " + r.stderr)
     check(r.stderr.count("nothing was run") == 1, "rank 0 alone reports it")
     check(not os.path.exists(os.path.join(refused_out, "summary.json")), "nothing written")
 
@@ -104,6 +107,37 @@ if r is not None:
     check(r.returncode != 0, "a failure on rank 0 ends the run with a non-zero exit")
     check("earlier run" in r.stderr or "domel_manifest" in r.stderr or "--overwrite" in r.stderr,
           "rank 0's message: " + r.stderr[:400])
+
+# 4. the silo: pour, deletion and plane on the ranks
+if silo:
+    with open(silo) as f:
+        doc = json.load(f)
+    doc["output"].pop("grids", None)
+    doc["output"]["vtk_interval"] = 0
+    doc["run"]["duration"] = 0.8
+    short = os.path.join(work, "silo.json")  # silo_ci names no other file
+    with open(short, "w") as f:
+        json.dump(doc, f)
+    p1 = os.path.join(work, "silo_one")
+    r1 = run([domel, "run", short, "--out", p1, "--quiet", "--max-steps", "12000"], timeout=600)
+    pn = os.path.join(work, "silo_ranks")
+    rn = run(mpi + [domel, "run", short, "--out", pn, "--quiet"], timeout=600)
+    check(r1 is not None and r1.returncode == 0, "the silo's pour on one process ran")
+    check(rn is not None and rn.returncode == 0, f"the silo on {np} ranks ran: {rn.stderr if rn else ''}")
+    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+        a = json.load(open(os.path.join(p1, "summary.json")))
+        b = json.load(open(os.path.join(pn, "summary.json")))
+        pa, pb = a["pours"][0], b["pours"][0]
+        check(pa["inserted"] == pb["inserted"] and pa["inserted_kg"] == pb["inserted_kg"],
+              f"the pour inserts what one process inserts: {pa['inserted']} {pa['inserted_kg']} against "
+              f"{pb['inserted']} {pb['inserted_kg']}")
+        bal = b["mass_balance"]["grains"]
+        check(bal["exact"] and bal["residual_units_1e-18kg"] == 0, f"the mass balance is exact: {bal}")
+        out = b["deletion_regions"]["outlet"]
+        check(out["removed"] > 100 and out["removed"] == bal["removed"], f"the outlet removed particles: {out}")
+        check(b["mass_flow"]["orifice"]["net_count"] >= out["removed"], "the plane counted what left")
+        print(f"silo on {np} ranks: {pb['inserted']} poured ({pb['inserted_kg']:.6g} kg, one process the same), "
+              f"{out['removed']} removed, plane {b['mass_flow']['orifice']['net_count']}, balance exact")
 
 print("passed" if not failures else f"{len(failures)} failure(s)")
 sys.exit(1 if failures else 0)
