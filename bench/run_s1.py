@@ -8,7 +8,9 @@ What is measured (see docs/benchmarks.md and ../shared/peers/RESULTS.md):
     domel:    `domel run bench/scenarios/s1_settle_<N>.json --time-after 2000` -> summary.json "timed_window"
     LIGGGHTS: the peers' deck (settle.in, RF none) -> N_actual * 2000 / 'Loop time' of the run after the
               BENCHMARK_TIMED_RUN_START marker (exactly as ../shared/peers/run_peers.sh computes it).
-  Both codes run serially (one process, OMP_NUM_THREADS=1). For each N the runs alternate
+  Both codes run serially (one process, OMP_NUM_THREADS=1), or with --ranks R both on R MPI ranks
+  (`mpirun -np R`; LIGGGHTS with `processors 1 1 R`, its deck's pz), and domel also as one process on R
+  threads (code domel_<R>t) for the ranks-against-threads comparison. For each N the runs alternate
   domel, LIGGGHTS, domel, LIGGGHTS, ... so that slow drifts of the machine's load hit both codes alike.
 
 Recorded per run (CSV in bench/results/s1_<timestamp>.csv): code, N requested/actual, rep, timed wall,
@@ -27,6 +29,7 @@ Usage:
     python3 bench/run_s1.py --quick               # N = 10000, 1 rep (smoke test)
     python3 bench/run_s1.py --deck bed --threads 1 2   # the dense settled bed (bench/make_bed.py, docs/benchmarks.md)
     python3 bench/run_s1.py --no-peer             # domel only
+    python3 bench/run_s1.py --ranks 2 --sizes 50000 200000   # both codes on 2 MPI ranks (+ domel 1 rank x 2 threads)
     python3 bench/run_s1.py --report bench/results/s1_<timestamp>.csv   # re-print the tables of a run
 Exit status: 0 when every run succeeded, 1 when any failed (all other runs are still done), 2 on bad usage.
 Only the Python standard library is used. The machine's load matters: on a shared machine, read the load
@@ -56,6 +59,15 @@ import make_bed  # noqa: E402
 
 # The deck being run: "s1" (S1/S2, the peers' settle.in) or "bed" (the dense settled bed of make_bed.py).
 DECK = {"name": "s1", "bed_dir": None}
+# MPI ranks per run (--ranks); 1: one process
+RANKS = {"n": 1}
+
+
+def mpirun(ranks):
+    """The launcher prefix for `ranks` processes (none for one)."""
+    if ranks <= 1:
+        return []
+    return [shutil.which("mpirun") or "mpirun", "-np", str(ranks)]
 
 NSETTLE = make_s1.NSETTLE
 NRUN = make_s1.NRUN
@@ -232,7 +244,7 @@ def build_epsd_example(domel, workdir):
     return os.path.join(out, "libdomel_rolling_epsd.so")
 
 
-def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
+def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none", ranks=1):
     expected = expected_particles(n)
     nsettle, nrun = steps()
     scen = deck_scenario(n, workdir, rolling)
@@ -242,7 +254,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
     row = {"code": code, "N_requested": n, "rep": rep, "log": log}
     row["load1_start"] = load1()
     shutil.rmtree(outdir, ignore_errors=True)  # a fresh folder (domel refuses one with an earlier run's output)
-    rc, wall, cpu, samples = run_timed([domel, "run", scen, "--out", outdir, "--quiet",
+    rc, wall, cpu, samples = run_timed(mpirun(ranks) + [domel, "run", scen, "--out", outdir, "--quiet",
                                "--time-after", str(nsettle), "--threads", str(threads)], workdir, log, timeout, env)
     row.update(load1_end=load1(), process_wall_s=wall, process_cpu_s=cpu)
     summary_path = os.path.join(outdir, "summary.json")
@@ -261,7 +273,7 @@ def run_domel(domel, n, rep, workdir, timeout, env, threads=1, rolling="none"):
     # domel has no CPU clock of its own around the timed steps: they are the last steps of the process, so
     # take the CPU time the process used in its last timed_wall_s seconds (sampled from /proc every 20 ms;
     # includes the few ms of summary writing and exit)
-    tcpu = cpu_in_last(samples, row["timed_wall_s"] or 0.0)
+    tcpu = cpu_in_last(samples, row["timed_wall_s"] or 0.0) if ranks == 1 else None  # mpirun's own CPU, not the ranks'
     if tcpu:
         row["timed_cpu_s"] = tcpu
         row["particle_steps_per_cpu_s"] = row["N_actual"] * row["timed_steps"] / tcpu
@@ -313,6 +325,8 @@ def run_liggghts(liggghts, deckdir, n, rep, workdir, timeout, env, rolling="none
         cmd = [liggghts, "-in", "bed.in", "-var", "data", make_bed.paths(DECK["bed_dir"], n)["data"]]
     else:
         cmd = [liggghts, "-in", "settle.in", "-var", "N", str(n)]
+    if RANKS["n"] > 1:
+        cmd = mpirun(RANKS["n"]) + cmd + ["-var", "pz", str(RANKS["n"])]
     cmd += ["-var", "nsettle", str(nsettle), "-var", "nrun", str(nrun), "-var", "RF", make_s1.PEER_RF.get(rolling, rolling), "-log", log]
     if shutil.which("stdbuf"):  # LIGGGHTS dies silently when stdout is a file (RESULTS.md, problem 2)
         cmd = ["stdbuf", "-oL"] + cmd
@@ -368,8 +382,12 @@ def print_tables(rows, sizes, have_peer, deck="S1 settle"):
     threaded = sorted({r["code"] for r in rows if r["code"].startswith("domel_")})
     if threaded:
         print()
-        print("domel with worker threads (wall-clock, timed steps) against serial LIGGGHTS; speed-up = over domel on "
-              "1 thread in the same invocation")
+        if RANKS["n"] > 1:
+            print("domel as one process with worker threads against both codes on %d ranks (wall-clock, timed "
+                  "steps); speed-up = over domel on %d ranks x 1 thread in the same invocation" % (RANKS["n"], RANKS["n"]))
+        else:
+            print("domel with worker threads (wall-clock, timed steps) against serial LIGGGHTS; speed-up = over "
+                  "domel on 1 thread in the same invocation")
         tl = []
         for code in threaded:
             for n in sizes:
@@ -380,7 +398,8 @@ def print_tables(rows, sizes, have_peer, deck="S1 settle"):
                 nact = next((r.get("N_actual") for r in mine if r.get("N_actual")), n)
                 tl.append([code, str(nact), fmt_rate(dt_), "%.2f" % (dt_[0] / d1[0]) if dt_ and d1 else "-",
                            "%.2f" % (dt_[0] / p[0]) if dt_ and p else "-"])
-        print_md(["domel", "N", "median [min-max]", "speed-up", "ratio domel/LIGGGHTS serial"], tl)
+        print_md(["domel", "N", "median [min-max]", "speed-up",
+                  "ratio domel/LIGGGHTS " + ("on %d ranks" % RANKS["n"] if RANKS["n"] > 1 else "serial")], tl)
 
     mem = []
     for n in sizes:
@@ -525,6 +544,9 @@ def main(argv=None):
                                            "build examples/third_party_rolling against the --domel build tree's SDK)")
     ap.add_argument("--threads", type=int, nargs="+", default=[1],
                     help="domel thread counts to run (default 1; e.g. --threads 1 2); LIGGGHTS always runs serially")
+    ap.add_argument("--ranks", type=int, default=1,
+                    help="MPI ranks for both codes (default 1: one process each); with R > 1, domel also runs "
+                         "as one process on R threads")
     ap.add_argument("--deck", choices=["s1", "bed"], default="s1",
                     help="s1: the peers' S1/S2 lattice column (default); bed: the dense settled bed of "
                          "bench/make_bed.py (both codes start from the same bed file; prepared once by domel, cached "
@@ -548,6 +570,13 @@ def main(argv=None):
         args.domel = os.path.abspath(args.domel) if os.sep in args.domel else args.domel
     if any(t < 1 for t in args.threads):
         ap.error("--threads expects counts >= 1")
+    if args.ranks < 1 or (args.ranks > 1 and args.deck != "s1"):
+        ap.error("--ranks expects a count >= 1, and runs the s1 deck only")
+    RANKS["n"] = args.ranks
+    if args.ranks > 1:
+        args.threads = [1]
+        env_ranks = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
+        os.environ.update(env_ranks)
     if not args.domel or not os.access(args.domel, os.X_OK):
         ap.error("no domel binary (build it: cmake -S . -B build-bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
                  "-DDOMEL_BUILD_TESTS=OFF && cmake --build build-bench), or pass --domel")
@@ -597,6 +626,9 @@ def main(argv=None):
     print("LIGGGHTS: %s" % (("%s, deck %s (copied to %s)" % (args.liggghts, os.path.join(args.peers, "liggghts"),
                                                                  deckdir)) if have_peer else "not run"))
     print("sizes %s, %d rep(s), logs in %s" % (" ".join(map(str, sizes)), reps, workdir))
+    if args.ranks > 1:
+        print("both codes on %d MPI ranks (code domel, liggghts); domel_%dt: domel as one process on %d threads"
+              % (args.ranks, args.ranks, args.ranks))
     print()
 
     os.makedirs(args.results, exist_ok=True)
@@ -612,8 +644,11 @@ def main(argv=None):
         for n in sizes:
             for rep in range(1, reps + 1):
                 jobs = [("domel", lambda t=t: run_domel(args.domel, n, rep, workdir, args.timeout, env, t,
-                                                        args.rolling))
+                                                        args.rolling, args.ranks))
                         for t in args.threads]
+                if args.ranks > 1:  # one process on as many threads, for the ranks-against-threads table
+                    jobs.append(("domel", lambda: run_domel(args.domel, n, rep, workdir, args.timeout, env,
+                                                            args.ranks, args.rolling, 1)))
                 if have_peer:
                     jobs.append(("liggghts", lambda: run_liggghts(args.liggghts, deckdir, n, rep, workdir,
                                                                   args.timeout, env, args.rolling)))

@@ -614,9 +614,11 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (writer && options.progress && tty) std::fprintf(stderr, "\n");
   if (ranks) {
     // every rank's particle-steps (rank 0's progress line counted its own)
-    std::vector<std::uint64_t> ps{static_cast<std::uint64_t>(particle_steps)};
+    std::vector<std::uint64_t> ps{static_cast<std::uint64_t>(particle_steps),
+                                  static_cast<std::uint64_t>(window_particle_steps)};
     ranks->sum(ps);
     particle_steps = static_cast<double>(ps[0]);
+    window_particle_steps = static_cast<double>(ps[1]);
   }
   if (probes) probes->flush();
   write_grids(static_cast<double>(m) * macro, true);
