@@ -72,16 +72,19 @@ std::string iso_time_now() {
 }
 
 /// output.region_mass: kilograms and count of the particles inside the
-/// region, and (when com is given) their centre of mass.
+/// region, and (when com is given) their centre of mass; subdomain d's
+/// particles are store_of(d) (its store, or its particles gathered from the ranks).
+template <class StoreOf>
 std::pair<double, std::size_t> mass_in_region(const std::vector<std::unique_ptr<Subdomain>>& subdomains,
-                                              const RegionMassProbe& rm, double* com = nullptr) {
+                                              StoreOf&& store_of, const RegionMassProbe& rm,
+                                              double* com = nullptr) {
   double kg = 0;
   std::size_t n = 0;
   double mx = 0, my = 0, mz = 0;
   const double v2max = rm.max_speed ? *rm.max_speed * *rm.max_speed : 0.0;
   for (std::size_t d = 0; d < subdomains.size(); ++d) {
     if (rm.subdomain != kAllSubdomains && rm.subdomain != d) continue;
-    const ParticleStore& s = subdomains[d]->store();
+    const ParticleStore& s = store_of(d);
     // the material's local index in this subdomain (none: it has no such particles)
     int local = -1;
     if (rm.material) {
@@ -151,8 +154,6 @@ std::vector<Diagnostic> Simulation::not_distributable() const {
   if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
   if (fluid) refuse("/fluid", "a fluid coupling");
   if (contact_sample.enabled()) refuse("/output", "wall loads or contact output (output.wall_loads, output.contacts)");
-  if (repose_probe) refuse("/output/repose_probe", "the repose probe");
-  if (!region_mass.empty()) refuse("/output/region_mass", "a region-mass probe");
   if (!servos.empty()) refuse("/walls", "a servo wall");
   if (checkpoint_interval > 0) refuse("/run/checkpoint_interval", "a checkpoint");
   return out;
@@ -404,12 +405,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       const SubdomainStats st = stats_of(k, t);
       for (const auto& c : kProbeColumns) row.push_back(c.value(st));
     }
+    auto at_t = [&](std::size_t k) -> const ParticleStore& { return particles_of(k, t); };
     if (repose_probe)
-      for (const auto& sd : subdomains)
-        row.push_back(repose_angle(sd->store(), *repose_probe).value_or(std::nan("")));
+      for (std::size_t k = 0; k < subdomains.size(); ++k)
+        row.push_back(repose_angle(at_t(k), *repose_probe).value_or(std::nan("")));
     for (const auto& rm : region_mass) {
       double com[3];
-      const auto [kg, n] = mass_in_region(subdomains, rm, com);
+      const auto [kg, n] = mass_in_region(subdomains, at_t, rm, com);
       row.push_back(kg);
       row.push_back(static_cast<double>(n));
       if (rm.centre_of_mass) row.insert(row.end(), com, com + 3);
@@ -705,18 +707,19 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                               {"wall_contacts", st.wall_contacts}}}});
     if (ranks) sds.back()["ranks_exchange"] = traffic;
   }
+  auto at_end = [&](std::size_t k) -> const ParticleStore& { return particles_of(k, result.simulated_time); };
   if (repose_probe) {
     nlohmann::json angles = nlohmann::json::object();
-    for (const auto& sd : subdomains) {
-      const auto a = repose_angle(sd->store(), *repose_probe);
-      angles[sd->name()] = a ? nlohmann::json(*a) : nlohmann::json(nullptr);
+    for (std::size_t k = 0; k < subdomains.size(); ++k) {
+      const auto a = repose_angle(at_end(k), *repose_probe);
+      angles[subdomains[k]->name()] = a ? nlohmann::json(*a) : nlohmann::json(nullptr);
     }
     summary["repose_angle_deg"] = angles;
   }
   if (!region_mass.empty()) {
     nlohmann::json rj = nlohmann::json::object();
     for (const auto& rm : region_mass) {
-      const auto [kg, n] = mass_in_region(subdomains, rm);
+      const auto [kg, n] = mass_in_region(subdomains, at_end, rm);
       rj[rm.name] = {{"mass_kg", kg}, {"particles", n}};
     }
     summary["region_mass"] = rj;
