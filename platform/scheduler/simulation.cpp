@@ -19,6 +19,7 @@
 #include "io/vtk_writer.hpp"
 #include "io/wall_surfaces.hpp"
 #include "scheduler/checkpoint.hpp"
+#include "scheduler/gathered_contacts.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -150,7 +151,6 @@ std::vector<Diagnostic> Simulation::not_distributable() const {
     out.push_back({file, pointer, what + " cannot run spread over MPI ranks yet (docs/distributed.md)",
                    "run it as one process: domel run without mpirun"});
   };
-  if (!grid_setups.empty()) refuse("/output/grids", "a cell grid");
   if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
   if (fluid) refuse("/fluid", "a fluid coupling");
   if (contact_sample.enabled()) refuse("/output", "wall loads or contact output (output.wall_loads, output.contacts)");
@@ -256,9 +256,9 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     grids.push_back(std::make_unique<CellGrid>(g.spec));
     grids.back()->set_accessible(walls, 0.0);
     grids.back()->set_periodic(subdomains[g.subdomain]->periodic());
-    grid_vtk.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridVtkSeries>(out, g.spec.name) : nullptr);
-    grid_csv.push_back(g.spec.write_interval > 0 ? std::make_unique<io::CellGridProfileCsv>(out, g.spec.name, g.profile_axis)
-                                                 : nullptr);
+    const bool files = writer && g.spec.write_interval > 0;  // every rank samples, rank 0 writes
+    grid_vtk.push_back(files ? std::make_unique<io::CellGridVtkSeries>(out, g.spec.name) : nullptr);
+    grid_csv.push_back(files ? std::make_unique<io::CellGridProfileCsv>(out, g.spec.name, g.profile_axis) : nullptr);
     grid_files.emplace_back(g.spec.write_interval, g.spec.write_interval, macro);
   }
   // Every grid that samples a subdomain: the output grids and both levels of each coupling.
@@ -284,6 +284,19 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     sd.set_record_contacts(record);
     sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
     if (!record) return;
+    if (ranks) {
+      // every rank samples its grids from every rank's particles and records
+      bool due = false;
+      for (const auto& s : samplers) due = due || (s.subdomain == k && s.grid->due(sd.steps()));
+      if (due) {
+        const ParticleStore all = ranks->gather(sd, true);
+        const std::vector<ContactRecord> records = gather_contact_records(*ranks, sd, all);
+        for (const auto& s : samplers)
+          if (s.subdomain == k && s.grid->due(sd.steps())) s.grid->sample(all, {&records}, sd.time());
+      }
+      sd.set_record_contacts(false);
+      return;
+    }
     const auto records = sd.contact_records();
     for (const auto& s : samplers) {
       if (s.subdomain != k || !s.grid->due(sd.steps())) continue;
