@@ -18,7 +18,9 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
 2. A scenario the distributed run cannot do yet (wall loads) is refused
    with its JSON pointer, on every rank, non-zero exit, nothing written.
 3. A failure on rank 0 alone (its output folder holds an earlier run) ends
-   every rank with a non-zero exit and that rank's message, never a hang.
+   every rank with a non-zero exit and that rank's message, never a hang;
+   so does a run that blows up (a time step 4 times the stability limit,
+   let through by a tiny impact velocity): the rank's message names it.
 4. The shaker example (a vibrating box, a binary mixture, region-mass
    probes by material with centres of mass) for 8000 steps: the region
    probes' masses and counts equal one process's in every row, the centres
@@ -143,6 +145,19 @@ if r is not None:
     check(r.returncode != 0, "a failure on rank 0 ends the run with a non-zero exit")
     check("earlier run" in r.stderr or "domel_manifest" in r.stderr or "--overwrite" in r.stderr,
           "rank 0's message: " + r.stderr[:400])
+
+# 3b. a run that blows up during the steps
+with open(scenario) as f:
+    doc = json.load(f)
+doc["subdomains"][0]["time_step"] = 6e-4
+doc["subdomains"][0]["impact_velocity"] = 1e-4
+blow = os.path.join(work, "blow.json")
+with open(blow, "w") as f:
+    json.dump(doc, f)
+r = run(mpi + [domel, "run", blow, "--out", os.path.join(work, "blow"), "--quiet"], timeout=120)
+if r is not None:
+    check(r.returncode == 1, f"a blown-up run ends with exit status 1 (found {r.returncode})")
+    check("failed on rank" in r.stderr and "non-finite" in r.stderr, "the rank's message: " + r.stderr[:400])
 
 # 4. the shaker: moving walls, materials, region-mass probes
 shaker = os.path.join(os.path.dirname(os.path.abspath(scenario)), "shaker.json")
