@@ -45,8 +45,7 @@ ParticleStore MpiRunRanks::gather(Subdomain& sd, bool everywhere) {
   std::iota(mine.begin(), mine.end(), 0u);
   std::vector<std::vector<char>> send(static_cast<std::size_t>(comm_.size()));
   send[0] = pack_particles(s, mine);
-  if (everywhere) send.assign(send.size(), send[0]);
-  const auto recv = comm_.all_to_all(send);
+  const auto recv = everywhere ? comm_.all_gather(send[0]) : comm_.all_to_all(send);
   ParticleStore all;
   if (s.has_external_force()) all.enable_external_force();
   all.add_aux(s.aux.size());

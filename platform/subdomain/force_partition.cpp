@@ -76,8 +76,6 @@ void ForcePartition::refresh_wall_work(const std::vector<WallNeighbors>& wall_li
   // docs/performance.md). Kept as (particle, cost of the entries up to this
   // one) in particle order, refreshed with the pair split (balance). Only
   // the split depends on it, never a result.
-  constexpr double kWallEntryCost = 1.0;
-  constexpr double kWallContactCost = 6.0;
   std::vector<std::pair<uint32_t, double>>& ev = wall_work_;
   ev.clear();
   for (std::size_t w = 0; w < wall_lists.size(); ++w) {
@@ -85,7 +83,7 @@ void ForcePartition::refresh_wall_work(const std::vector<WallNeighbors>& wall_li
     const WallNeighbors& list = wall_lists[w];
     const auto mid = static_cast<std::ptrdiff_t>(ev.size());
     for (std::size_t e = 0; e < list.particle.size(); ++e)  // ascending particle order
-      ev.emplace_back(list.particle[e], kWallEntryCost + (list.touching[e] ? kWallContactCost : 0.0));
+      ev.emplace_back(list.particle[e], static_cast<double>(kWallEntryCost + (list.touching[e] ? kWallContactCost : 0)));
     std::inplace_merge(ev.begin(), ev.begin() + mid, ev.end(),
                        [](const auto& x, const auto& y) { return x.first < y.first; });
   }
@@ -163,7 +161,7 @@ void ForcePartition::balance(const NeighborList& list, bool far_active, const st
                              const std::vector<WallPrimitive>& walls_now, double time, std::uint64_t step,
                              std::size_t particles) {
   // Contiguous ranges of each tier of the pair list with near-equal estimated
-  // cost: an entry costs 1 (the overlap screen) and a contact kContactCost
+  // cost: an entry costs 1 (the overlap screen) and a contact kPairContactCost
   // more (the contact kernels and the scatter; the value's measurement is in
   // docs/performance.md). Even entry counts leave the thread with the dense,
   // settled bottom of a column with most of the work. While the contacts
@@ -171,7 +169,6 @@ void ForcePartition::balance(const NeighborList& list, bool far_active, const st
   // unless the threads' estimated costs in the last force evaluation (their
   // ranges' entries, and their contacts as counted there) differ by more
   // than kRebalanceAt.
-  constexpr uint64_t kContactCost = 12;
   constexpr std::uint64_t kBalanceEvery = 32;
   constexpr double kRebalanceAt = 0.01;
   const int nt = threads();
@@ -182,7 +179,7 @@ void ForcePartition::balance(const NeighborList& list, bool far_active, const st
     for (std::size_t q = 0; q < static_cast<std::size_t>(nt); ++q) {
       std::size_t entries = split_[0][q + 1] - split_[0][q];
       if (far_active) entries += split_[1][q + 1] - split_[1][q];
-      const double cost = static_cast<double>(entries + kContactCost * contacts[q].pair_contacts);
+      const double cost = static_cast<double>(entries + kPairContactCost * contacts[q].pair_contacts);
       lo = q == 0 ? cost : std::min(lo, cost);
       hi = q == 0 ? cost : std::max(hi, cost);
     }
@@ -198,11 +195,11 @@ void ForcePartition::balance(const NeighborList& list, bool far_active, const st
     split.assign(static_cast<std::size_t>(nt) + 1, end);
     split[0] = begin;
     uint64_t total = end - begin;
-    for (std::size_t e = begin; e < end; ++e) total += kContactCost * touching[e];
+    for (std::size_t e = begin; e < end; ++e) total += kPairContactCost * touching[e];
     uint64_t run = 0;
     int t = 1;
     for (std::size_t e = begin; e < end && t < nt; ++e) {
-      run += 1 + kContactCost * touching[e];
+      run += 1 + kPairContactCost * touching[e];
       while (t < nt && run * static_cast<uint64_t>(nt) >= total * static_cast<uint64_t>(t)) split[t++] = e + 1;
     }
     // The particle-index span each thread's pairs touch (zones).

@@ -44,6 +44,15 @@ class ForcePartition {
     }
   };
 
+  /// The estimated cost of the force evaluation's pieces, in units of one
+  /// pair-list entry's overlap screen (measured on S2 at 10k,
+  /// docs/performance.md): a pair contact (contact kernels, scatter), a
+  /// wall-list entry (its gap test), a wall contact. The threads' split and
+  /// the ranks' decomposition (Subdomain::rank_costs) weigh the work alike.
+  static constexpr std::uint64_t kPairContactCost = 12;
+  static constexpr std::uint64_t kWallEntryCost = 1;
+  static constexpr std::uint64_t kWallContactCost = 6;
+
   void set_threads(int threads);
   int threads() const { return static_cast<int>(threads_.size()); }
 

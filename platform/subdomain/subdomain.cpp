@@ -136,18 +136,18 @@ void Subdomain::reset_forces() {
 }
 
 std::vector<std::uint64_t> Subdomain::rank_costs() const {
-  // the weights of ForcePartition (a list entry 1, a contact 12 more; a wall
-  // entry 1, a wall contact 6 more), per particle that leads the work; every
-  // particle costs at least 1. Particles added since the build (a pour)
-  // count 1.
+  // the threads' weights (ForcePartition's costs), per particle that leads
+  // the work; every particle costs at least 1. Particles added since the
+  // build (a pour) count 1.
+  using FP = ForcePartition;
   const std::size_t n = owned();
   std::vector<std::uint64_t> cost(n, 1);
   if (nlist_.layout_stale(store_)) return cost;
   for (std::size_t e = 0; e < nlist_.size(); ++e)
-    if (nlist_.i[e] < n) cost[nlist_.i[e]] += 1 + 12 * nlist_.touching[e];
+    if (nlist_.i[e] < n) cost[nlist_.i[e]] += 1 + FP::kPairContactCost * nlist_.touching[e];
   for (const WallNeighbors& w : wall_lists_)
     for (std::size_t e = 0; e < w.particle.size(); ++e)
-      if (w.particle[e] < n) cost[w.particle[e]] += 1 + 6 * w.touching[e];
+      if (w.particle[e] < n) cost[w.particle[e]] += FP::kWallEntryCost + FP::kWallContactCost * w.touching[e];
   return cost;
 }
 
