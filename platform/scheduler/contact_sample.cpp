@@ -38,8 +38,12 @@ void ContactSample::begin(double t) {
 }
 
 void ContactSample::take(std::size_t k, const Subdomain& sd, const std::vector<WallPrimitive>& walls) {
-  const ParticleStore& s = sd.store();
-  const auto records = sd.contact_records();
+  take(k, sd, sd.store(), sd.contact_records(), walls);
+}
+
+void ContactSample::take(std::size_t k, const Subdomain& sd, const ParticleStore& s,
+                         const std::vector<const std::vector<ContactRecord>*>& records,
+                         const std::vector<WallPrimitive>& walls) {
   for (const auto* list : records)
     for (const ContactRecord& c : *list) {
       const bool wall = c.j == ContactRecord::kWall;

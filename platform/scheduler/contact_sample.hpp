@@ -9,6 +9,8 @@
 // written.
 #pragma once
 
+#include "averaging/cell_grid.hpp"
+#include "core/particle_store.hpp"
 #include "geometry/wall.hpp"
 #include "io/contact_writer.hpp"
 #include "scheduler/particle_flow.hpp"
@@ -52,6 +54,11 @@ class ContactSample {
   /// Subdomain::set_record_contacts) at the sample's time. `walls` are the
   /// scenario's wall primitives, as the subdomain indexes them.
   void take(std::size_t k, const Subdomain& sd, const std::vector<WallPrimitive>& walls);
+  /// The same from particles `s` and their contact records (a subdomain
+  /// spread over ranks: every rank's particles and records, gathered;
+  /// scheduler/gathered_contacts.hpp); sd gives the material pairs.
+  void take(std::size_t k, const Subdomain& sd, const ParticleStore& s,
+            const std::vector<const std::vector<ContactRecord>*>& records, const std::vector<WallPrimitive>& walls);
 
   /// Append the probes' values at time t to a probes.csv row: the sample's
   /// when it was taken at t (within `tolerance` s), NaN otherwise.

@@ -7,11 +7,13 @@
 // one through RunOptions::ranks; without one the run is one process.
 #pragma once
 
+#include "core/error.hpp"
 #include "core/particle_store.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace domel::platform {
@@ -33,6 +35,22 @@ class RunRanks {
   virtual std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) = 0;
   /// Element-wise sums over the ranks, in place. Collective.
   virtual void sum(std::vector<std::uint64_t>& v) = 0;
+  /// Element-wise sums over the ranks, added up in rank order, so the same
+  /// bits on every rank and run to run for a given rank count. Collective.
+  std::vector<double> sum_in_rank_order(const std::vector<double>& mine) {
+    std::vector<char> bytes(mine.size() * sizeof(double));
+    if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
+    std::vector<double> total(mine.size(), 0.0);
+    for (const auto& b : all_gather(bytes)) {
+      if (b.size() != bytes.size()) throw RuntimeError("sum over the ranks: the ranks sent different lengths");
+      for (std::size_t k = 0; k < total.size(); ++k) {
+        double x;
+        std::memcpy(&x, b.data() + k * sizeof(double), sizeof(double));
+        total[k] += x;
+      }
+    }
+    return total;
+  }
   /// The largest x over the ranks. Collective.
   virtual double max(double x) = 0;
   /// What sd's ranks exchanged since the start, summed over the ranks (for

@@ -2,20 +2,25 @@
 #include "scheduler/servo.hpp"
 
 #include "core/archive.hpp"
+#include "scheduler/run_ranks.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <algorithm>
 
 namespace domel::platform {
 
-void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains) {
-  for (WallServo& s : servos) {
-    double f[3] = {0, 0, 0};
+void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains, RunRanks* ranks) {
+  std::vector<double> load(3 * servos.size(), 0.0);  // on this rank's particles
+  for (std::size_t k = 0; k < servos.size(); ++k)
     for (const auto& sd : subdomains) {
       double g[3];
-      sd->wall_load(s.wall, g);
-      for (int a = 0; a < 3; ++a) f[a] += g[a];
+      sd->wall_load(servos[k].wall, g);
+      for (int a = 0; a < 3; ++a) load[3 * k + a] += g[a];
     }
+  if (ranks) load = ranks->sum_in_rank_order(load);
+  for (std::size_t k = 0; k < servos.size(); ++k) {
+    WallServo& s = servos[k];
+    const double* f = &load[3 * k];
     // the particles push the wall back against its direction
     s.measured = 0.0 - (f[0] * s.direction[0] + f[1] * s.direction[1] + f[2] * s.direction[2]);
     const double vmax = s.state->max_velocity;

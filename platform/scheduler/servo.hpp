@@ -24,6 +24,7 @@
 namespace domel::platform {
 
 class Subdomain;
+class RunRanks;
 class ArchiveWriter;
 class ArchiveReader;
 
@@ -43,8 +44,9 @@ class WallServos {
   std::vector<WallServo> servos;
 
   bool empty() const { return servos.empty(); }
-  /// After a macro step ending at t: measure and set the velocities.
-  void update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  /// After a macro step ending at t: measure and set the velocities. Spread
+  /// over ranks, the loads are summed over them (every rank moves the wall alike).
+  void update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains, RunRanks* ranks = nullptr);
   /// probes.csv: <name>.servo_force [N] (F at the last update) and <name>.servo_travel [m] (along the direction).
   std::vector<std::string> columns() const;
   void append_values(double t, std::vector<double>& row) const;

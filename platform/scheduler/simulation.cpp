@@ -29,6 +29,7 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <ctime>
 #include <unistd.h>
 
@@ -153,8 +154,6 @@ std::vector<Diagnostic> Simulation::not_distributable() const {
   };
   if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
   if (fluid) refuse("/fluid", "a fluid coupling");
-  if (contact_sample.enabled()) refuse("/output", "wall loads or contact output (output.wall_loads, output.contacts)");
-  if (!servos.empty()) refuse("/walls", "a servo wall");
   if (checkpoint_interval > 0) refuse("/run/checkpoint_interval", "a checkpoint");
   return out;
 }
@@ -212,10 +211,23 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (ranks) ranks->distribute(*sd);
     if (!ck) sd->setup();
   }
+  // Wall loads and contact rows from subdomain k's recorded contacts; spread
+  // over ranks, from every rank's particles and records, gathered on every
+  // rank (the same sums everywhere: a servo moves its wall alike on all).
+  auto take_contact_sample = [&](std::size_t k, const ParticleStore* all,
+                                 const std::vector<ContactRecord>* gathered) {
+    Subdomain& sd = *subdomains[k];
+    if (!ranks) return contact_sample.take(k, sd, walls);
+    std::optional<ParticleStore> mine;
+    if (!all) all = &mine.emplace(ranks->gather(sd, true));
+    std::optional<std::vector<ContactRecord>> records;
+    if (!gathered) gathered = &records.emplace(gather_contact_records(*ranks, sd, *all));
+    contact_sample.take(k, sd, *all, {gathered}, walls);
+  };
   if (!ck && contact_sample.enabled()) {
     contact_sample.begin(0.0);
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
-      contact_sample.take(k, *subdomains[k], walls);
+      take_contact_sample(k, nullptr, nullptr);
       subdomains[k]->set_record_contacts(false);
     }
   }
@@ -288,11 +300,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       // every rank samples its grids from every rank's particles and records
       bool due = false;
       for (const auto& s : samplers) due = due || (s.subdomain == k && s.grid->due(sd.steps()));
-      if (due) {
+      if (due || for_outputs) {
         const ParticleStore all = ranks->gather(sd, true);
         const std::vector<ContactRecord> records = gather_contact_records(*ranks, sd, all);
         for (const auto& s : samplers)
           if (s.subdomain == k && s.grid->due(sd.steps())) s.grid->sample(all, {&records}, sd.time());
+        if (for_outputs) take_contact_sample(k, &all, &records);
       }
       sd.set_record_contacts(false);
       return;
@@ -330,7 +343,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   // Servo walls: the loads of the macro step's last force evaluation set
   // the velocities of the next one.
   if (!servos.empty())
-    run_hooks.after.push_back([this](const MacroStep& step) { servos.update(step.t, subdomains); });
+    run_hooks.after.push_back([this, ranks](const MacroStep& step) { servos.update(step.t, subdomains, ranks); });
   // The fluid exchange: all levels stand at the same time at a macro-step start.
   if (fluid)
     run_hooks.before.push_back([this](const MacroStep& step) {
@@ -410,7 +423,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   std::unique_ptr<io::WallSurfaceSeries> wall_vtk;
   if (vtk && wall_surfaces && !walls.empty()) wall_vtk = std::make_unique<io::WallSurfaceSeries>(out, "walls");
   std::unique_ptr<io::ContactSeriesWriter> contact_vtk;
-  if (contact_sample.wants_rows() && contact_interval > 0)
+  const bool contact_framing = contact_sample.wants_rows() && contact_interval > 0;  // on every rank: collective
+  if (contact_framing && writer)
     contact_vtk = std::make_unique<io::ContactSeriesWriter>(out, "contacts");
   auto write_probes = [&](double t) {
     std::vector<double> row = {t};
@@ -445,6 +459,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (probes) probes->flush();  // probes.csv reaches the frame just written
   };
   auto write_contacts = [&](double t) {
+    if (!contact_vtk) return;  // another rank writes
     const std::vector<io::ContactRow>* rows = contact_sample.rows_at(t, kTimeTolerance * macro);
     if (!rows) spdlog::warn("contacts: no contacts were recorded for t = {:.6g} s; its file is empty", t);
     contact_vtk->write(t, rows ? *rows : std::vector<io::ContactRow>{});
@@ -459,7 +474,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
 
   Interval probe_rows(probing ? probe_interval : 0.0, 0.0, macro);
   Interval vtk_frames(framing ? vtk_interval : 0.0, 0.0, macro);
-  Interval contact_frames(contact_vtk ? contact_interval : 0.0, 0.0, macro);
+  Interval contact_frames(contact_framing ? contact_interval : 0.0, 0.0, macro);
   Interval checkpoints(checkpoint_interval, checkpoint_interval, macro);
   std::uint64_t m = 0;
   if (ck) {
@@ -596,7 +611,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     // the contacts of the macro step's last steps, when an output at its end needs them
     const double t_end = static_cast<double>(m + 1) * macro;
-    const bool sample = contact_sample.enabled() && ((probes && contact_sample.has_probes() && probe_rows.due(t_end)) ||
+    const bool sample = contact_sample.enabled() && ((probing && contact_sample.has_probes() && probe_rows.due(t_end)) ||
                                                      contact_frames.due(t_end));
     if (sample) contact_sample.begin(t_end);
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
