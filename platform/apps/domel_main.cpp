@@ -172,14 +172,18 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
 /// SIGINT and SIGTERM ask the run to stop after its current step
 /// (core/interrupt.hpp); a second one ends the process at once (the handler
 /// resets itself).
+volatile std::sig_atomic_t g_announce_stop = 1;  ///< 0 on the ranks other than 0 (rank 0 speaks for the run)
+
 extern "C" void on_stop_signal(int sig) {
   dp::request_interrupt(sig);
+  if (!g_announce_stop) return;
   const char msg[] = "\ndomel: stopping after this step, writing a checkpoint and the outputs (again to quit at once)\n";
   const ssize_t ignored = ::write(2, msg, sizeof msg - 1);
   (void)ignored;
 }
 
 void install_stop_handlers() {
+  g_announce_stop = world().rank() == 0 ? 1 : 0;
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);
@@ -251,7 +255,8 @@ int cmd_run(int argc, char** argv) {
                 result.wall_seconds, result.particle_steps_per_second, result.output_directory.string().c_str());
     if (result.interrupted_by) {
       const bool ck = result.summary.contains("checkpoint");
-      std::fprintf(stderr, "domel: interrupted at t = %.6g s; %s\n", result.simulated_time,
+      if (world().rank() == 0)
+        std::fprintf(stderr, "domel: interrupted at t = %.6g s; %s\n", result.simulated_time,
                    ck ? ("continue with: domel run " + a.positional[0] + " --restart " +
                          (result.output_directory / result.summary["checkpoint"].get<std::string>()).string())
                             .c_str()
@@ -428,7 +433,10 @@ int main(int argc, char** argv) {
   // a failure on one rank ends every rank (the others may wait in a
   // collective). A refused scenario is refused alike on every rank, and rank
   // 0 reports it: the others give it a second to do so before ending the run.
-  if (code != 0 && world().size() > 1) {
+  // A run stopped by a signal stopped on every rank at the same macro step
+  // and wrote its checkpoint together: the ranks end normally.
+  const bool stopped = code == 128 + SIGINT || code == 128 + SIGTERM;
+  if (code != 0 && world().size() > 1 && !stopped) {
     if (code == kExitRefused && world().rank() != 0) std::this_thread::sleep_for(std::chrono::seconds(1));
     world().abort(code);
   }

@@ -100,7 +100,14 @@ void ArchiveReader::fail(const std::string& key, const std::string& what) const 
 ArchiveReader::ArchiveReader(const std::filesystem::path& path) : path_(path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail("", "cannot be opened");
-  const std::string buf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  parse(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+}
+
+ArchiveReader::ArchiveReader(const std::string& bytes, std::filesystem::path label) : path_(std::move(label)) {
+  parse(bytes);
+}
+
+void ArchiveReader::parse(const std::string& buf) {
   std::size_t pos = 0;
   auto need = [&](std::size_t n, const char* what) {
     if (buf.size() - pos < n) fail("", std::string("is truncated (in ") + what + ")");

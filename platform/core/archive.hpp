@@ -77,6 +77,9 @@ class ArchiveWriter {
 class ArchiveReader {
  public:
   explicit ArchiveReader(const std::filesystem::path& path);
+  /// An archive held in memory (one serialized into a section of another);
+  /// `label` names it in the errors (the file and the section).
+  ArchiveReader(const std::string& bytes, std::filesystem::path label);
   const std::string& header() const { return header_; }
   const std::filesystem::path& path() const { return path_; }
   bool has(const std::string& key) const { return sections_.count(key) != 0; }
@@ -111,6 +114,7 @@ class ArchiveReader {
     std::string data;
   };
   const Section& find(const std::string& key, ArchiveType type) const;
+  void parse(const std::string& bytes);
   std::filesystem::path path_;
   std::string header_;
   std::map<std::string, Section> sections_;

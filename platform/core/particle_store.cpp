@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <type_traits>
 
 namespace domel::platform {
 
@@ -145,6 +147,18 @@ void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
   bool same = true;
   for_each_array([&](const auto& v) { same = same && v.size() == n; });
   if (!same) r.fail(p + "id", "has per-particle arrays of different lengths");
+}
+
+void ParticleStore::append(const ParticleStore& other) {
+  if (other.external_force_ != external_force_ || other.aux.size() != aux.size())
+    throw std::invalid_argument("ParticleStore::append: the stores differ in external forces or aux arrays");
+  std::vector<const void*> from;
+  other.for_each_array([&](const auto& v) { from.push_back(&v); });
+  std::size_t k = 0;
+  for_each_array([&](auto& v) {
+    const auto& src = *static_cast<const std::remove_reference_t<decltype(v)>*>(from[k++]);
+    v.insert(v.end(), src.begin(), src.end());
+  });
 }
 
 }  // namespace domel::platform

@@ -99,6 +99,9 @@ struct ParticleStore {
 
   /// Apply a permutation: new index k holds old particle order[k].
   void permute(const std::vector<std::uint32_t>& order);
+  /// Append every particle of `other` (the same external-force switch and
+  /// aux count: throws std::invalid_argument otherwise).
+  void append(const ParticleStore& other);
 
   /// The order that sorts the particles by cubic cells of side `cell`, cell
   /// rows in z-y-x order (ties keep the current order): new index k holds

@@ -293,4 +293,42 @@ void GhostExchange::reverse_counts(ParticleStore& s, const Communicator& comm) c
   }
 }
 
+
+void GhostExchange::save(ArchiveWriter& w, const std::string& p) const {
+  std::vector<std::uint64_t> first(first_.begin(), first_.end()), counts;
+  std::vector<std::uint32_t> sent;
+  std::vector<double> shift;
+  for (std::size_t r = 0; r < sent_.size(); ++r) {
+    counts.push_back(sent_[r].size());
+    sent.insert(sent.end(), sent_[r].begin(), sent_[r].end());
+    for (const auto& a : shift_[r]) shift.insert(shift.end(), a.begin(), a.end());
+  }
+  w.put(p + "first", first);
+  w.put(p + "sent_counts", counts);
+  w.put(p + "sent", sent);
+  w.put(p + "shift", shift);
+}
+
+void GhostExchange::load(const ArchiveReader& r, const std::string& p, int ranks) {
+  const auto first = r.get<std::uint64_t>(p + "first");
+  const auto counts = r.get<std::uint64_t>(p + "sent_counts");
+  const auto sent = r.get<std::uint32_t>(p + "sent");
+  const auto shift = r.get<double>(p + "shift");
+  const auto n = static_cast<std::size_t>(ranks);
+  if (first.size() != n + 1 || counts.size() != n)
+    r.fail(p + "first", "was written on " + std::to_string(counts.size()) + " ranks, not " + std::to_string(ranks));
+  std::size_t total = 0;
+  for (auto c : counts) total += c;
+  if (sent.size() != total || shift.size() != 3 * total) r.fail(p + "sent", "does not match its counts");
+  first_.assign(first.begin(), first.end());
+  sent_.assign(n, {});
+  shift_.assign(n, {});
+  std::size_t at = 0;
+  for (std::size_t q = 0; q < n; ++q)
+    for (std::uint64_t c = 0; c < counts[q]; ++c, ++at) {
+      sent_[q].push_back(sent[at]);
+      shift_[q].push_back({shift[3 * at], shift[3 * at + 1], shift[3 * at + 2]});
+    }
+}
+
 }  // namespace domel::platform

@@ -6,6 +6,7 @@
 // module adds to the store (external forces, aux arrays) travels with it.
 #pragma once
 
+#include "core/archive.hpp"
 #include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
 #include "distributed/communicator.hpp"
@@ -13,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace domel::platform {
@@ -81,6 +83,10 @@ class GhostExchange {
   /// Bytes sent to other ranks by one update() and by one reverse().
   std::size_t update_bytes() const;
   std::size_t reverse_bytes() const;
+  /// Checkpoints: who-went-where of the last build (what update() and
+  /// reverse() read until the next build).
+  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void load(const ArchiveReader& r, const std::string& prefix, int ranks);
 
  private:
   /// Throws unless s holds the particles of the last build.

@@ -20,6 +20,13 @@ class MpiRunRanks final : public RunRanks {
   void distribute(Subdomain& sd) override;
   ParticleStore gather(Subdomain& sd, bool everywhere = false) override;
   std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) override { return comm_.all_gather(mine); }
+  std::vector<std::vector<char>> gather_to_root(const std::vector<char>& mine) override {
+    std::vector<std::vector<char>> send(static_cast<std::size_t>(comm_.size()));
+    send[0] = mine;
+    auto recv = comm_.all_to_all(send);
+    if (comm_.rank() != 0) recv.clear();
+    return recv;
+  }
   void sum(std::vector<std::uint64_t>& v) override { comm_.sum(v); }
   double max(double x) override { return comm_.max(x); }
   nlohmann::json traffic(const Subdomain& sd) override;

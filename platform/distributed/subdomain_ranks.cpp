@@ -63,6 +63,20 @@ std::size_t SubdomainRanks::migrate(ParticleStore& s, std::size_t owned, const s
   return s.size();
 }
 
+void SubdomainRanks::save(ArchiveWriter& w, const std::string& p) const {
+  ghosts_.save(w, p + "ghosts/");
+  const RankTraffic& t = traffic_;
+  w.put(p + "traffic", std::vector<std::uint64_t>{t.migrations, t.migrated, t.histories_sent, t.ghost_builds, t.ghosts,
+                                                  t.updates, t.update_bytes, t.reverses, t.reverse_bytes});
+}
+
+void SubdomainRanks::load(const ArchiveReader& r, const std::string& p) {
+  ghosts_.load(r, p + "ghosts/", comm_.size());
+  const auto v = r.get<std::uint64_t>(p + "traffic");
+  if (v.size() != 9) r.fail(p + "traffic", "holds " + std::to_string(v.size()) + " counters, expected 9");
+  traffic_ = {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]};
+}
+
 void SubdomainRanks::build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) {
   const ExchangeCounts c = ghosts_.build(s, owned, d_, cutoff, comm_, box_);
   ++traffic_.ghost_builds;

@@ -43,6 +43,10 @@ class SubdomainRanks final : public RankExchange {
   void update_ghosts(ParticleStore& s) override;
   void reverse(ParticleStore& s) override;
   void reverse_counts(ParticleStore& s) override { ghosts_.reverse_counts(s, comm_); }
+  int rank() const override { return comm_.rank(); }
+  int size() const override { return comm_.size(); }
+  void save(ArchiveWriter& w, const std::string& prefix) const override;
+  void load(const ArchiveReader& r, const std::string& prefix) override;
 
   const Communicator& communicator() const { return comm_; }
   const Decomposition& decomposition() const { return d_; }

@@ -7,6 +7,7 @@
 #include "loader/plugin_registry.hpp"
 #include "coupling/coupling.hpp"
 #include "fluid/fluid_coupling.hpp"
+#include "scheduler/run_ranks.hpp"
 #include "scheduler/simulation.hpp"
 
 #include <ctime>
@@ -72,7 +73,22 @@ nlohmann::json stateful_models(const Simulation& sim) {
 }  // namespace
 
 void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
-                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra) {
+                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra,
+                      RunRanks* ranks) {
+  // spread over ranks: every rank's part of each subdomain, on rank 0
+  std::vector<std::vector<std::vector<char>>> parts(sim.subdomains.size());
+  std::vector<std::uint64_t> owned(sim.subdomains.size());
+  if (ranks) {
+    for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
+      ArchiveWriter part;
+      sim.subdomains[k]->save(part, "");
+      const std::string bytes = part.serialize("{}");
+      parts[k] = ranks->gather_to_root(std::vector<char>(bytes.begin(), bytes.end()));
+      owned[k] = sim.subdomains[k]->owned();
+    }
+    ranks->sum(owned);
+    if (ranks->rank() != 0) return;
+  }
   ArchiveWriter w;
   nlohmann::json header;
   header["format"] = kFormat;
@@ -88,10 +104,14 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
   header["simulated_time_s"] = loop.time;
   header["macro_step_index"] = loop.macro_index;
   header["threads"] = loop.threads;
+  header["ranks"] = ranks ? ranks->size() : 1;
   nlohmann::json sds = nlohmann::json::array();
-  for (auto& sd : sim.subdomains)
-    sds.push_back({{"name", sd->name()}, {"coarse_grain", sd->coarse_grain()}, {"particles", sd->size()},
-                   {"steps", sd->steps()}, {"time_step_s", sd->time_step()}});
+  for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
+    const Subdomain& sd = *sim.subdomains[k];
+    sds.push_back({{"name", sd.name()}, {"coarse_grain", sd.coarse_grain()},
+                   {"particles", ranks ? owned[k] : sd.size()}, {"steps", sd.steps()},
+                   {"time_step_s", sd.time_step()}});
+  }
   header["subdomains"] = sds;
   header["models"] = sim.models_used;
   header["stateful_models"] = stateful_models(sim);
@@ -107,7 +127,15 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
                                                                   static_cast<std::uint64_t>(loop.threads)});
   w.put(std::string("loop/reals"), std::vector<double>{loop.time, loop.probe_period, loop.vtk_period});
   w.put(std::string("loop/vtk_times"), loop.vtk_times);
-  for (std::size_t k = 0; k < sim.subdomains.size(); ++k) sim.subdomains[k]->save(w, sd_prefix(k));
+  for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
+    if (!ranks) {
+      sim.subdomains[k]->save(w, sd_prefix(k));
+      continue;
+    }
+    w.put_scalar<std::uint64_t>(sd_prefix(k) + "ranks", parts[k].size());
+    for (std::size_t r = 0; r < parts[k].size(); ++r)
+      w.put_text(sd_prefix(k) + "rank" + std::to_string(r), std::string(parts[k][r].begin(), parts[k][r].end()));
+  }
   sim.flow.save(w, "flow/");
   if (extra) extra(w);
   io::write_file_atomically(file, w.serialize(header.dump()));
@@ -196,15 +224,44 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
   ck.loop.probe_period = reals[1];
   ck.loop.vtk_period = reals[2];
   ck.loop.vtk_times = r.get<double>("loop/vtk_times");
+  const nlohmann::json ranks = ck.header.value("ranks", nlohmann::json(1));
+  if (!ranks.is_number_unsigned() || ranks.get<std::uint64_t>() < 1)
+    r.fail("", "has a header whose \"ranks\" is not a positive count");
+  ck.loop.ranks = ranks.get<int>();
   return ck;
 }
 
-bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim) {
+bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim, RunRanks* ranks) {
   bool same_split = true;
+  const ArchiveReader& r = *ck.archive;
   // the servos' travel first: the subdomains place their walls with it
-  if (!sim.servos.empty()) sim.servos.load(*ck.archive, "servos/");
-  for (std::size_t k = 0; k < sim.subdomains.size(); ++k)
-    same_split = sim.subdomains[k]->restore(*ck.archive, sd_prefix(k)) && same_split;
+  if (!sim.servos.empty()) sim.servos.load(r, "servos/");
+  for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
+    const std::string p = sd_prefix(k);
+    const std::uint64_t written_on = r.has(p + "ranks") ? r.scalar<std::uint64_t>(p + "ranks") : 1;
+    const std::uint64_t now = ranks ? static_cast<std::uint64_t>(ranks->size()) : 1;
+    if (written_on != now) {
+      // another rank count: every part read, the particles shared out anew
+      std::vector<std::unique_ptr<ArchiveReader>> nested;
+      std::vector<std::pair<const ArchiveReader*, std::string>> parts;
+      if (written_on == 1) parts.emplace_back(&r, p);
+      for (std::uint64_t q = 0; written_on > 1 && q < written_on; ++q) {
+        const std::string key = p + "rank" + std::to_string(q);
+        nested.push_back(std::make_unique<ArchiveReader>(r.text(key), r.path().string() + " (section '" + key + "')"));
+        parts.emplace_back(nested.back().get(), "");
+      }
+      sim.subdomains[k]->restore_shared_out(parts);
+      same_split = false;
+      continue;
+    }
+    if (!ranks) {
+      same_split = sim.subdomains[k]->restore(r, p) && same_split;
+      continue;
+    }
+    const std::string key = p + "rank" + std::to_string(ranks->rank());
+    const ArchiveReader part(r.text(key), r.path().string() + " (section '" + key + "')");
+    same_split = sim.subdomains[k]->restore(part, "") && same_split;
+  }
   sim.flow.restore(*ck.archive, "flow/", sim.subdomains);
   return same_split;
 }

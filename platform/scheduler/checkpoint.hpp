@@ -21,6 +21,7 @@ namespace domel::platform {
 
 class Simulation;
 class PluginRegistry;
+class RunRanks;
 
 /// The checkpoint file's name in the output folder.
 inline constexpr const char* kCheckpointFile = "checkpoint.ckpt";
@@ -37,13 +38,20 @@ struct LoopState {
   std::uint64_t probe_bytes = 0;     ///< probes.csv's length after its last flush
   std::vector<double> vtk_times;     ///< frames of particles.pvd
   int threads = 1;
+  int ranks = 1;  ///< the processes the run was spread over (header "ranks")
 };
 
 /// Write `file` atomically: the header, the loop state, every subdomain and
 /// the particle flow. Finishes every subdomain's pending step first.
 /// `extra` adds the sections of what the run loop owns (cell grids and their files).
+///
+/// Spread over ranks (`ranks`), every rank calls it: each subdomain is
+/// written as one part per rank (that rank's own particles, ghosts, lists
+/// and exchange), gathered to rank 0, which writes the file; what every rank
+/// holds alike (the loop, the flow, `extra`) is rank 0's.
 void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
-                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra = {});
+                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra = {},
+                      RunRanks* ranks = nullptr);
 
 /// A checkpoint opened for a restart and checked against the scenario.
 struct OpenedCheckpoint {
@@ -65,6 +73,8 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
 /// (instead of Subdomain::setup() and ParticleFlow::start()). Returns false
 /// when some subdomain's thread split could not be restored (another thread
 /// count): the run then differs from the uninterrupted one by round-off.
-bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim);
+/// Spread over ranks, every rank restores its own part of each subdomain
+/// (a checkpoint of the same rank count: the run goes on bit for bit).
+bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim, RunRanks* ranks = nullptr);
 
 }  // namespace domel::platform

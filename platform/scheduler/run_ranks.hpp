@@ -33,6 +33,8 @@ class RunRanks {
   virtual ParticleStore gather(Subdomain& sd, bool everywhere = false) = 0;
   /// Every rank's bytes, on every rank, by rank. Collective.
   virtual std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) = 0;
+  /// Every rank's bytes, by rank, on rank 0 (on the others: none). Collective.
+  virtual std::vector<std::vector<char>> gather_to_root(const std::vector<char>& mine) = 0;
   /// Element-wise sums over the ranks, in place. Collective.
   virtual void sum(std::vector<std::uint64_t>& v) = 0;
   /// Element-wise sums over the ranks, added up in rank order, so the same

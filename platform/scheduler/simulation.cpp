@@ -154,7 +154,6 @@ std::vector<Diagnostic> Simulation::not_distributable() const {
   };
   if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
   if (fluid) refuse("/fluid", "a fluid coupling");
-  if (checkpoint_interval > 0) refuse("/run/checkpoint_interval", "a checkpoint");
   return out;
 }
 
@@ -166,15 +165,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const bool writer = ranks == nullptr || ranks->rank() == 0;
   if (ranks) {
     std::vector<Diagnostic> refused = not_distributable();
-    if (!options.restart.empty())
-      refused.push_back({scenario_file.string(), "", "a restart cannot run spread over MPI ranks yet", ""});
     if (!refused.empty()) throw ConfigError(refused);
   }
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
   // A restart is checked against this scenario before anything is written.
-  const std::string why_not =
-      ranks ? std::string("a run spread over MPI ranks cannot write checkpoints yet") : why_no_checkpoint();
+  const std::string why_not = why_no_checkpoint();
   const bool checkpoints_possible = why_not.empty();
   std::optional<OpenedCheckpoint> ck;
   if (!options.restart.empty()) {
@@ -231,11 +227,20 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       subdomains[k]->set_record_contacts(false);
     }
   }
+  flow.set_ranks(ranks);
   if (ck) {
-    if (!restore_checkpoint(*ck, *this))
+    const int ranks_now = ranks ? ranks->size() : 1;
+    if (ck->loop.ranks != ranks_now) {
+      if (writer)
+        spdlog::warn("restart on {} rank(s), the checkpoint was written on {}: the particles are shared out anew and "
+                     "the forces summed in another order, so the run differs from an uninterrupted one by round-off",
+                     ranks_now, ck->loop.ranks);
+      restore_checkpoint(*ck, *this, ranks);
+    } else if (!restore_checkpoint(*ck, *this, ranks) && writer) {
       spdlog::warn("restart on {} thread(s), the checkpoint was written on {}: the forces are summed in another "
                    "order, so the run differs from an uninterrupted one by round-off", threads_requested,
                    ck->loop.threads);
+    }
     spdlog::info("restart from {}: t = {:.6g} s, macro step {}", options.restart.string(), ck->loop.time,
                  ck->loop.macro_index);
   }
@@ -256,7 +261,6 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   for (const auto& c : flow.columns()) columns.push_back(c);
   for (const auto& c : contact_sample.columns()) columns.push_back(c);
   for (const auto& c : servos.columns()) columns.push_back(c);
-  flow.set_ranks(ranks);
   if (!ck) flow.start(subdomains);
 
   // Cell grids: accessible volume from the walls present at the start.
@@ -550,7 +554,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
         w.put("contacts/frame_times", contact_vtk->frame_times());
       }
       if (wall_vtk) w.put("walls/frame_times", wall_vtk->frame_times());
-    });
+    }, ranks);
     spdlog::debug("checkpoint at t = {:.6g} s written in {:.3g} s", ls.time,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   };

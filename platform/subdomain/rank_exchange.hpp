@@ -10,11 +10,13 @@
 // list build, update_ghosts at ghost_update, reverse at reverse_exchange.
 #pragma once
 
+#include "core/archive.hpp"
 #include "core/neighbor_list.hpp"
 #include "core/particle_store.hpp"
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace domel::platform {
@@ -42,6 +44,13 @@ class RankExchange {
   virtual void reverse(ParticleStore& s) = 0;
   /// The ghosts' contact counts added to their owners'. Collective.
   virtual void reverse_counts(ParticleStore& s) = 0;
+  /// This rank's size of the exchange (a checkpoint holds one part per rank).
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  /// Checkpoints: what the steps until the next build read (who holds
+  /// which ghosts) and the traffic counted so far. Not collective.
+  virtual void save(ArchiveWriter& w, const std::string& prefix) const = 0;
+  virtual void load(const ArchiveReader& r, const std::string& prefix) = 0;
 };
 
 }  // namespace domel::platform

@@ -187,6 +187,13 @@ class Subdomain {
   /// round-off). Throws ConfigError when the checkpoint does not fit this
   /// subdomain.
   bool restore(const ArchiveReader& r, const std::string& prefix);
+  /// Restore from a checkpoint written on another number of ranks (or one
+  /// process): `parts` are its parts of this subdomain (reader, prefix), one
+  /// per rank it was written on. This rank takes the particles it would own
+  /// at a start (id modulo the rank count) with their contact histories;
+  /// the exchange and a list build then place them, so the run is a valid
+  /// continuation (the sums' order differs: round-off). Collective.
+  void restore_shared_out(const std::vector<std::pair<const ArchiveReader*, std::string>>& parts);
 
   double time() const { return time_; }
   std::uint64_t steps() const { return steps_; }
@@ -203,6 +210,10 @@ class Subdomain {
   MemoryUse memory_use() const;
 
  private:
+  /// The checkpoint part under prefix into this subdomain (store, lists,
+  /// clocks); returns the part's own particle count (a rank's part: its
+  /// owned ones; one process: all).
+  std::size_t load_state(const ArchiveReader& r, const std::string& prefix);
   /// synchronize() for the const observers (store(), stats(),
   /// contact_records()): the pending kick is an internal deferral, not
   /// observable state.

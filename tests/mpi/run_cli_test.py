@@ -15,7 +15,7 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
    measured at most 1e-8 on 2-4 ranks); run again on NP ranks, probes.csv
    and the last particle frame are the same bytes (reproducible for a given
    rank count).
-2. A scenario the distributed run cannot do yet (checkpoints) is refused
+2. A scenario the distributed run cannot do yet (a fluid coupling) is refused
    with its JSON pointer, on every rank, non-zero exit, nothing written.
 3. A failure on rank 0 alone (its output folder holds an earlier run) ends
    every rank with a non-zero exit and that rank's message, never a hang;
@@ -34,6 +34,14 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
    chaos of the impacts back into the wall: the ranks' round-off (1e-16 at
    the first contacts) reaches 2e-9 of the lid's force at 1000 steps and
    1e-3 at 3000 (measured on 3 ranks), so the comparison stops at 1000.
+7. Checkpoints every 0.005 s: restarted at 1200 steps on NP ranks, the run
+   to 2000 writes the uninterrupted run's probes.csv and frames byte for
+   byte; restarted on another rank count (NP + 1; one process for NP = 4),
+   and from one process's checkpoint on NP ranks, the kinetic energy stays
+   within 1e-6 of the uninterrupted run's largest (round-off, as in 1.).
+   SIGTERM to every rank (as a batch system sends it) ends the run on every
+   rank with a checkpoint, no MPI_Abort, a non-zero status; the run then
+   goes on from it.
 5. With SILO (silo_ci.json; its cell grids removed, its duration cut to
    0.8 s, the outlet opens at 0.5 s): pour, deletion region and mass-flow
    plane on NP ranks: the pour inserts the particles one process inserts
@@ -135,15 +143,19 @@ if not failures:
 # 2. refused on every rank, nothing written
 with open(scenario) as f:
     doc = json.load(f)
-doc["run"]["checkpoint_interval"] = 0.01
-refused_scenario = os.path.join(work, "checkpointed.json")
+doc["fluid"] = {"model": "vans", "interval": 1e-4, "density": 1.2, "viscosity": 1.8e-5,
+                "grid": {"min": [0, 0, 0], "max": [0.02856, 0.02856, 0.12], "cells": [2, 2, 8]},
+                "boundaries": {"x_min": {"type": "wall"}, "x_max": {"type": "wall"}, "y_min": {"type": "wall"},
+                               "y_max": {"type": "wall"}, "z_min": {"type": "wall"},
+                               "z_max": {"type": "pressure_outlet"}}}
+refused_scenario = os.path.join(work, "fluid.json")
 with open(refused_scenario, "w") as f:
     json.dump(doc, f)
 refused_out = os.path.join(work, "refused")
 r = run(mpi + [domel, "run", refused_scenario, "--out", refused_out, "--quiet"])
 if r is not None:
-    check(r.returncode != 0, "checkpoints under mpirun are refused")
-    check("/run/checkpoint_interval" in r.stderr and "MPI ranks" in r.stderr, "the refusal names the pointer: " + r.stderr)
+    check(r.returncode != 0, "a fluid coupling under mpirun is refused")
+    check("/fluid" in r.stderr and "MPI ranks" in r.stderr, "the refusal names the pointer: " + r.stderr)
     check(r.stderr.count("nothing was run") == 1, "rank 0 alone reports it")
     check(not os.path.exists(os.path.join(refused_out, "summary.json")), "nothing written")
 
@@ -233,6 +245,78 @@ if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode ==
                 m = re.search(r'NumberOfLines="(\d+)"', f.read(4000).decode("latin-1"))
             counts.append(int(m.group(1)) if m else -1)
         check(counts[0] == counts[1] and counts[0] > 100, f"{name}: {counts[0]} contacts on one process, {counts[1]} on the ranks")
+
+# 7. checkpoints: a restart on the same rank count goes on bit for bit; on
+# another rank count (and from one process's checkpoint) it is a valid
+# continuation; SIGTERM to the ranks ends every one with a checkpoint
+with open(scenario) as f:
+    doc = json.load(f)
+doc["run"]["checkpoint_interval"] = 0.005
+doc["output"]["vtk_interval"] = 0.005
+ck_scenario = os.path.join(work, "ck.json")
+with open(ck_scenario, "w") as f:
+    json.dump(doc, f)
+ck_full, ck_part = os.path.join(work, "ck_full"), os.path.join(work, "ck_part")
+other = 1 if np == 4 else np + 1
+ck_other, ck_from_one = os.path.join(work, "ck_other"), os.path.join(work, "ck_from_one")
+runs = [run(mpi + [domel, "run", ck_scenario, "--out", ck_full, "--quiet", "--max-steps", "2000"]),
+        run(mpi + [domel, "run", ck_scenario, "--out", ck_part, "--quiet", "--max-steps", "1200"]),
+        run([domel, "run", ck_scenario, "--out", ck_from_one, "--quiet", "--max-steps", "1200"])]
+check(all(r is not None and r.returncode == 0 for r in runs), "the checkpointed runs ran")
+if not failures or all(r is not None and r.returncode == 0 for r in runs):
+    shutil.copytree(ck_part, ck_other)
+    restart = ["--quiet", "--max-steps", "2000", "--restart"]
+    r_same = run(mpi + [domel, "run", ck_scenario, "--out", ck_part] + restart + [os.path.join(ck_part, "checkpoint.ckpt")])
+    r_other = run(([mpiexec, "-np", str(other), "--oversubscribe"] if other > 1 else []) +
+                  [domel, "run", ck_scenario, "--out", ck_other] + restart + [os.path.join(ck_other, "checkpoint.ckpt")])
+    r_one = run(mpi + [domel, "run", ck_scenario, "--out", ck_from_one] + restart +
+                [os.path.join(ck_from_one, "checkpoint.ckpt")])
+    for r, what in ((r_same, f"on {np} ranks"), (r_other, f"on {other} rank(s)"), (r_one, "of one process on the ranks")):
+        check(r is not None and r.returncode == 0, f"the restart {what} ran: {r.stderr if r else ''}")
+    if all(r is not None and r.returncode == 0 for r in (r_same, r_other, r_one)):
+        same = [f for f in os.listdir(ck_full) if f == "probes.csv" or f.endswith(".vtp")]
+        check(len(same) >= 5, f"files to compare: {same}")
+        for name in same:
+            with open(os.path.join(ck_full, name), "rb") as f1, open(os.path.join(ck_part, name), "rb") as f2:
+                check(f1.read() == f2.read(), f"{name}: the restart on {np} ranks writes the uninterrupted run's bytes")
+        check(r_other.stderr.count("shared out anew") == 1, "the other rank count's restart says it is a continuation")
+        h0, p0 = probes(ck_full)
+        ke = h0.index("column.ke_translational")
+        scale = max(row[ke] for row in p0)
+        for folder, what in ((ck_other, f"{other} rank(s)"), (ck_from_one, "one process's checkpoint")):
+            h, pr = probes(folder)
+            check(h == h0 and len(pr) == len(p0), f"the restart on {what}: the same probe rows")
+            worst = max(abs(a[ke] - b[ke]) / scale for a, b in zip(p0, pr))
+            print(f"restart on {what} from the checkpoint at 1200 steps: kinetic energy within {worst:.3g} of "
+                  f"the uninterrupted {np}-rank run's largest")
+            check(worst < 1e-6, f"the restart on {what}: kinetic energy within 1e-6 (found {worst:.3g})")
+    # SIGTERM to every rank (as a batch system sends it)
+    doc["run"]["duration"] = 5.0
+    long_scenario = os.path.join(work, "ck_long.json")
+    with open(long_scenario, "w") as f:
+        json.dump(doc, f)
+    ck_sig = os.path.join(work, "ck_signal")
+    proc = subprocess.Popen(mpi + [domel, "run", long_scenario, "--out", ck_sig, "--quiet"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    import time
+    deadline = time.time() + 60
+    while time.time() < deadline and not os.path.exists(os.path.join(ck_sig, "particles_000002.vtp")):
+        time.sleep(0.2)
+    subprocess.run(["pkill", "-TERM", "-f", f"domel run {long_scenario} --out {ck_sig}"])
+    try:
+        out, err = proc.communicate(timeout=60)
+        check(proc.returncode != 0, "a run stopped by SIGTERM ends with a non-zero status")
+        summary = json.load(open(os.path.join(ck_sig, "summary.json")))
+        check(summary["status"] == "interrupted" and summary.get("checkpoint") == "checkpoint.ckpt",
+              f"summary.json: interrupted, with its checkpoint: {summary.get('status')}")
+        check(err.count("interrupted at t =") == 1 and "MPI_ABORT" not in err,
+              "every rank ended cleanly, rank 0 said where: " + err[-400:])
+        r = run(mpi + [domel, "run", long_scenario, "--out", ck_sig, "--quiet", "--max-steps",
+                       str(summary["steps"] + 100), "--restart", os.path.join(ck_sig, "checkpoint.ckpt")])
+        check(r is not None and r.returncode == 0, "the interrupted run goes on from its checkpoint")
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        check(False, "SIGTERM to the ranks: a hang")
 
 # 5. the silo: pour, deletion and plane on the ranks
 if silo:

@@ -452,3 +452,35 @@ TEST(WallNeighbors, LiveHistoriesAdoptedByAnotherListAreCarriedByIds) {
   part.build(s, floor, 0.002, 3, true, 50);
   for (std::uint32_t k : part.particle) EXPECT_LT(k, 50u);
 }
+
+TEST(ParticleStore, AppendKeepsEveryArrayOfBothStoresInOrder) {
+  // what a restart on another rank count does with the parts it keeps
+  // (Subdomain::restore_shared_out): every per-particle array, the external
+  // forces and aux arrays included, of a then b
+  auto make = [](std::uint64_t first, int n) {
+    ParticleStore s;
+    s.enable_external_force();
+    s.add_aux(1);
+    for (int k = 0; k < n; ++k) {
+      s.add(first + static_cast<std::uint64_t>(k), 0.1 * k, 0.2 * k, 0.3 * k, 0.001, 2500.0);
+      s.fx.back() = static_cast<double>(first) + k;
+      s.ext_fz.back() = -1.0 * (static_cast<double>(first) + k);
+      s.aux[0].back() = 7.0 * (static_cast<double>(first) + k);
+    }
+    return s;
+  };
+  ParticleStore a = make(10, 3);
+  const ParticleStore b = make(20, 2);
+  a.append(b);
+  ASSERT_EQ(a.size(), 5u);
+  const std::vector<std::uint64_t> ids = {10, 11, 12, 20, 21};
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    EXPECT_EQ(a.id[k], ids[k]);
+    EXPECT_EQ(a.fx[k], static_cast<double>(ids[k]));
+    EXPECT_EQ(a.ext_fz[k], -static_cast<double>(ids[k]));
+    EXPECT_EQ(a.aux[0][k], 7.0 * static_cast<double>(ids[k]));
+  }
+  EXPECT_EQ(a.z[4], b.z[1]);
+  ParticleStore plain;
+  EXPECT_THROW(plain.append(b), std::invalid_argument);
+}
