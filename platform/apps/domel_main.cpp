@@ -202,6 +202,8 @@ int cmd_run(int argc, char** argv) {
   check_thread_environment();
   if (a.flag("--quiet")) spdlog::set_level(spdlog::level::warn);
   if (a.flag("--verbose")) spdlog::set_level(spdlog::level::debug);
+  // every rank computes what rank 0 does (warnings included): rank 0 speaks for the run
+  if (world().rank() != 0) spdlog::set_level(spdlog::level::err);
   dp::RunOptions opt;
   std::unique_ptr<dp::MpiRunRanks> ranks;
   if (world().size() > 1) {
@@ -428,7 +430,7 @@ int main(int argc, char** argv) {
   const bool spread = argc >= 2 && std::string(argv[1]) == "run" && dp::Communicator::launched_by_mpirun();
   dp::MpiSession mpi(&argc, &argv, spread);
   world() = dp::Communicator::world();
-  if (world().rank() != 0) spdlog::set_level(spdlog::level::warn);
+  if (world().rank() != 0) spdlog::set_level(spdlog::level::err);
   const int code = dispatch(argc, argv);
   // a failure on one rank ends every rank (the others may wait in a
   // collective). A refused scenario is refused alike on every rank, and rank

@@ -133,7 +133,9 @@ bool Communicator::launched_by_mpirun() {
 MpiSession::MpiSession(int* argc, char*** argv, bool use) {
 #ifdef DOMEL_HAVE_MPI
   if (use && !mpi_running()) {
-    check(MPI_Init(argc, argv), "MPI_Init");
+    // threads inside each rank; only the main thread calls MPI
+    int provided = 0;
+    check(MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
     initialised_ = true;
   }
 #else

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/particle_store.hpp"
 #include "io/cell_grid_output.hpp"
+#include "scheduler/run_ranks.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <spdlog/spdlog.h>
@@ -70,9 +71,12 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
   std::vector<domel_level_v1*> level_ptrs(nl);
   std::vector<domel_fluid_drag_v1*> drag_ptrs(nl);
   std::vector<const double*> mean_ptrs(nl);
+  // spread over ranks: the coupler sees every rank's particles, gathered
+  std::vector<ParticleStore> gathered(ranks_ ? nl : 0);
   for (std::size_t L = 0; L < nl; ++L) {
     Subdomain& sd = *subdomains[spec_.levels[L]];
-    ParticleStore& s = sd.store();
+    if (ranks_) gathered[L] = ranks_->gather(sd, true);
+    ParticleStore& s = ranks_ ? gathered[L] : sd.store();
     auto& x = s.aux;
     const std::size_t a = aux_[L], n = s.size();
     for (std::size_t q = kBeta; q <= kFz; ++q) std::fill(x[a + q].begin(), x[a + q].end(), 0.0);
@@ -149,8 +153,22 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
     auto& x = s.aux;
     const std::size_t a = aux_[L];
     const double dt = sd.time_step();
+    const std::size_t n = sd.owned();
+    if (ranks_) {
+      // this rank's particles take their drag from the gathered copy (id order)
+      const ParticleStore& all = gathered[L];
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto it = std::lower_bound(all.id.begin(), all.id.end(), s.id[k]);
+        if (it == all.id.end() || *it != s.id[k])
+          throw RuntimeError(spec_.where + ": particle id " + std::to_string(s.id[k]) + " of subdomain '" +
+                             sd.name() + "' is missing from the particles gathered for the fluid");
+        const auto g = static_cast<std::size_t>(it - all.id.begin());
+        for (std::size_t q = kBeta; q <= kFz; ++q) x[a + q][k] = all.aux[a + q][g];
+        for (std::size_t q = kSx; q <= kSt; ++q) x[a + q][k] = 0.0;
+      }
+    }
     std::array<double, 3> net{0, 0, 0};
-    for (std::size_t k = 0; k < s.size(); ++k) {
+    for (std::size_t k = 0; k < n; ++k) {
       const double beta = x[a + kBeta][k];
       if (!(beta >= 0) || !std::isfinite(beta)) {
         std::ostringstream os;
@@ -175,6 +193,10 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
       s.fz[k] += f[2] - x[a + kLz][k];
       x[a + kLx][k] = f[0], x[a + kLy][k] = f[1], x[a + kLz][k] = f[2];
       for (int d = 0; d < 3; ++d) net[d] += f[d];
+    }
+    if (ranks_) {
+      const std::vector<double> total = ranks_->sum_in_rank_order({net[0], net[1], net[2]});
+      net = {total[0], total[1], total[2]};
     }
     net_force_[L] = net;
   }
@@ -241,7 +263,7 @@ void FluidCoupling::load(const ArchiveReader& r, const std::string& p, const std
     for (int d = 0; d < 3; ++d) net_force_[L][d] = v[4 + 3 * L + d];
   last_limit_ = r.text(p + "limit");
   const auto times = r.get<double>(p + "field_times");
-  if (!times.empty()) {
+  if (!times.empty() && (!ranks_ || ranks_->rank() == 0)) {  // rank 0 writes the fields
     fields_out_ = std::make_unique<io::FieldImageSeries>(out, "fluid");
     fields_out_->resume(times);
   }

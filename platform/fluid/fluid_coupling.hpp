@@ -31,6 +31,7 @@
 namespace domel::platform {
 
 class Subdomain;
+class RunRanks;
 
 class ArchiveWriter;
 class ArchiveReader;
@@ -72,6 +73,11 @@ class FluidCoupling {
   /// interval, or when a particle's drag relaxation time m/beta is shorter
   /// than its level's time step.
   void exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  /// A run spread over ranks: every rank gathers each level's particles
+  /// (every rank's, in id order) and gives the coupler the same question, so
+  /// the fluid is the same on every rank; each rank keeps its own particles'
+  /// drag. Null: one process.
+  void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
 
   /// Write the coupler's fields when due (or, `final`, at the end whatever
   /// the interval) into <out>/fluid_<NNNNNN>.vti and fluid.pvd.
@@ -91,6 +97,7 @@ class FluidCoupling {
   nlohmann::json summary() const;
 
  private:
+  RunRanks* ranks_ = nullptr;
   // aux array offsets within each level's block (ParticleStore::aux)
   // beta and u; the held force; the velocity integral and its time; the
   // fluid force last applied (replaced in f at an exchange)

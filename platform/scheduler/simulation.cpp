@@ -153,7 +153,6 @@ std::vector<Diagnostic> Simulation::not_distributable() const {
                    "run it as one process: domel run without mpirun"});
   };
   if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
-  if (fluid) refuse("/fluid", "a fluid coupling");
   return out;
 }
 
@@ -228,6 +227,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
   }
   flow.set_ranks(ranks);
+  if (fluid) fluid->set_ranks(ranks);
   if (ck) {
     const int ranks_now = ranks ? ranks->size() : 1;
     if (ck->loop.ranks != ranks_now) {
@@ -610,7 +610,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     if (m > 0)
       for (auto& c : couplings) c->write_grids(t, false);
-    if (fluid && m < stop) fluid->write_fields(t, false, out);
+    if (fluid && m < stop && writer) fluid->write_fields(t, false, out);
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     // the contacts of the macro step's last steps, when an output at its end needs them
@@ -657,7 +657,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (probes) probes->flush();
   write_grids(static_cast<double>(m) * macro, true);
   for (auto& c : couplings) c->write_grids(static_cast<double>(m) * macro, true);
-  if (fluid) fluid->write_fields(static_cast<double>(m) * macro, true, out);
+  if (fluid && writer) fluid->write_fields(static_cast<double>(m) * macro, true, out);
 
   result.macro_steps = m;
   result.simulated_time = static_cast<double>(m) * macro;

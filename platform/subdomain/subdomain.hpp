@@ -99,7 +99,7 @@ class Subdomain {
   void set_rank_exchange(std::unique_ptr<RankExchange> ranks);
   bool distributed() const { return ranks_ != nullptr; }
   /// The particles this rank owns: store()[0, owned()); the rest are ghosts.
-  std::size_t owned() const { return ranks_ ? owned_ : store_.size(); }
+  std::size_t owned() const { return ranks_ && !edited_ ? owned_ : store_.size(); }
   /// The store to add particles to or remove them from between steps (a
   /// pour, a deletion region, an inflow): store(), without the ghosts when
   /// distributed (what is added or removed is this rank's own; the next step
