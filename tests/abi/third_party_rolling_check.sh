@@ -13,6 +13,9 @@
 #    options that make it LIGGGHTS epsd2 (Iwashita-Oda stiffness, no dashpot),
 #    and for a copy in which the material pair names epsd
 #    (interactions[].rolling) and the subdomain has no rolling model;
+# 3b. with an MPI build and mpirun: the scenario for 6000 steps on 2 and 3
+#    ranks (the plugin loaded on every rank, never told of the ranks) within
+#    1e-6 of one process's largest kinetic energy (round-off);
 # 4. `domel validate` on a copy with a misspelt epsd parameter: exit code 2
 #    and a did-you-mean naming the right key; the same for a misspelt
 #    stiffness value, and `domel run` on viscous damping without a dashpot:
@@ -103,6 +106,35 @@ for e in errors:
 sys.exit(1 if errors else 0)
 EOF
 done
+
+echo "== 3b. the same plugin in a run spread over 2 and 3 MPI ranks (mpirun), against one process"
+if command -v mpirun >/dev/null && ldd "$domel" | grep -q libmpi; then
+  "$domel" run "$tmp/build/scenario.json" --out "$tmp/out_one" --quiet --max-steps 6000 >"$tmp/run.log" 2>&1 ||
+    { cat "$tmp/run.log" >&2; fail "domel run (6000 steps) failed"; }
+  for np in 2 3; do
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader \
+      timeout 300 mpirun -np $np --oversubscribe "$domel" run "$tmp/build/scenario.json" --out "$tmp/out_np$np" \
+      --quiet --max-steps 6000 >"$tmp/run.log" 2>&1 || { cat "$tmp/run.log" >&2; fail "mpirun -np $np failed"; }
+    # the pile falls and collides for 6000 steps (0.06 s): within round-off of one process
+    # (the tolerance 1e-6 of the largest kinetic energy is the MPI CLI test's)
+    python3 - "$tmp/out_one" "$tmp/out_np$np" "$np" <<'EOF' || fail "the run on $np ranks differs from one process"
+import csv, json, os, sys
+one, many, np = sys.argv[1], sys.argv[2], sys.argv[3]
+s = json.load(open(os.path.join(many, "summary.json")))
+assert s["ranks"] == int(np), s["ranks"]
+assert s["models"]["pile"]["rolling"]["library"] == "third_party_rolling", s["models"]
+rows = [list(csv.DictReader(open(os.path.join(d, "probes.csv")))) for d in (one, many)]
+assert len(rows[0]) == len(rows[1]) > 5
+peak = max(float(r["pile.ke_translational"]) for r in rows[0])
+worst = max(abs(float(a[c]) - float(b[c])) / peak for a, b in zip(*rows)
+            for c in ("pile.ke_translational", "pile.ke_rotational"))
+print(f"epsd on {np} ranks: kinetic energies within {worst:.3g} of one process's largest")
+sys.exit(0 if worst < 1e-6 else 1)
+EOF
+  done
+else
+  echo "(no MPI build or no mpirun: skipped)"
+fi
 
 echo "== 4. domel validate reports a misspelt epsd parameter"
 sed 's/"rolling_friction"/"rolling_fricton"/' "$tmp/build/scenario.json" >"$tmp/build/scenario_typo.json"
