@@ -49,6 +49,9 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
    frames, one fluid series. Measured on 3 ranks: 2.6e-10 at 0.1 s (the
    bubbling bed is chaotic: at 0.2 s the ranks differ by 8e-3 and one
    process on 2 threads by 2.5e-4 from 1 thread).
+9. The column on an STL mesh floor of 32 triangles (the box open at its
+   bottom) for 3000 steps: the kinetic energy within 1e-6 of one process's
+   largest, the same wall-contact count in every row.
 5. With SILO (silo_ci.json; its cell grids removed, its duration cut to
    0.8 s, the outlet opens at 0.5 s): pour, deletion region and mass-flow
    plane on NP ranks: the pour inserts the particles one process inserts
@@ -342,6 +345,44 @@ if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode ==
     frames1 = sorted(f for f in os.listdir(f1) if f.startswith("fluid_"))
     check(frames1 == sorted(f for f in os.listdir(fn) if f.startswith("fluid_")) and len(frames1) >= 1,
           "the same fluid frames")
+
+# 9. a mesh wall across the ranks: the column settles on an STL floor of 32 triangles
+with open(scenario) as f:
+    doc = json.load(f)
+side, cells = 0.02856, 4
+with open(os.path.join(work, "floor.stl"), "w") as f:
+    f.write("solid floor\n")
+    for i in range(cells):
+        for j in range(cells):
+            x0, x1, y0, y1 = i * side / cells, (i + 1) * side / cells, j * side / cells, (j + 1) * side / cells
+            for t in (((x0, y0), (x1, y0), (x1, y1)), ((x0, y0), (x1, y1), (x0, y1))):
+                f.write(" facet normal 0 0 1\n  outer loop\n")
+                for x, y in t:
+                    f.write(f"   vertex {x!r} {y!r} 0\n")
+                f.write("  endloop\n endfacet\n")
+    f.write("endsolid floor\n")
+doc["walls"][0]["open"] = ["zmin", "zmax"]
+doc["walls"].append({"name": "floor", "type": "mesh", "material": "beads", "file": "floor.stl"})
+meshed = os.path.join(work, "mesh_floor.json")
+with open(meshed, "w") as f:
+    json.dump(doc, f)
+m1, mn = os.path.join(work, "mesh_one"), os.path.join(work, "mesh_ranks")
+r1 = run([domel, "run", meshed, "--out", m1, "--quiet", "--max-steps", "3000"])
+rn = run(mpi + [domel, "run", meshed, "--out", mn, "--quiet", "--max-steps", "3000"])
+check(r1 is not None and r1.returncode == 0, "the mesh floor on one process ran")
+check(rn is not None and rn.returncode == 0, f"the mesh floor on {np} ranks ran: {rn.stderr if rn else ''}")
+if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    h1, p1 = probes(m1)
+    hn, pn = probes(mn)
+    ke, wc = h1.index("column.ke_translational"), h1.index("column.wall_contacts")
+    scale = max(row[ke] for row in p1)
+    worst = max(abs(a[ke] - b[ke]) / scale for a, b in zip(p1, pn))
+    print(f"mesh floor on {np} ranks: kinetic energy within {worst:.3g} of one process's largest; wall contacts "
+          f"at the end {p1[-1][wc]:.0f} (one process) {pn[-1][wc]:.0f}")
+    check(h1 == hn and len(p1) == len(pn), "the mesh floor's probe rows")
+    check(worst < 1e-6, f"the mesh floor: kinetic energy within 1e-6 (found {worst:.3g})")
+    check(all(a[wc] == b[wc] for a, b in zip(p1, pn)) and p1[-1][wc] > 100,
+          "the same wall contacts in every row, more than 100 at the end (the floor carries the column)")
 
 # 5. the silo: pour, deletion and plane on the ranks
 if silo:
