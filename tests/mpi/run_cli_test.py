@@ -52,6 +52,10 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
 9. The column on an STL mesh floor of 32 triangles (the box open at its
    bottom) for 3000 steps: the kinetic energy within 1e-6 of one process's
    largest, the same wall-contact count in every row.
+10. A pour across the rank borders (random fills into the box every 0.005 s,
+   6 g in all) for 6000 steps (the first fills land by 0.03 s): the
+   same particles and kg as one process, the same count in every probe row,
+   the kinetic energy within 1e-6.
 5. With SILO (silo_ci.json; its cell grids removed, its duration cut to
    0.8 s, the outlet opens at 0.5 s): pour, deletion region and mass-flow
    plane on NP ranks: the pour inserts the particles one process inserts
@@ -383,6 +387,38 @@ if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode ==
     check(worst < 1e-6, f"the mesh floor: kinetic energy within 1e-6 (found {worst:.3g})")
     check(all(a[wc] == b[wc] for a, b in zip(p1, pn)) and p1[-1][wc] > 100,
           "the same wall contacts in every row, more than 100 at the end (the floor carries the column)")
+
+# 10. a pour across the rank borders: random fills into the box every 0.005 s
+with open(scenario) as f:
+    doc = json.load(f)
+sd = doc["subdomains"][0]
+sd.pop("insert")
+sd["pour"] = [{"insert": {"model": "random", "diameter": 0.0028, "volume_fraction": 0.05,
+                          "region": {"box": {"min": [0, 0, 0.005], "max": [0.02856, 0.02856, 0.035]}}},
+                "mass_rate": 0.2, "total_mass": 0.006, "interval": 0.005}]
+poured = os.path.join(work, "pour.json")
+with open(poured, "w") as f:
+    json.dump(doc, f)
+q1, qn = os.path.join(work, "pour_one"), os.path.join(work, "pour_ranks")
+r1 = run([domel, "run", poured, "--out", q1, "--quiet", "--max-steps", "6000"])
+rn = run(mpi + [domel, "run", poured, "--out", qn, "--quiet", "--max-steps", "6000"])
+check(r1 is not None and r1.returncode == 0, f"the pour on one process ran: {r1.stderr if r1 else ''}")
+check(rn is not None and rn.returncode == 0, f"the pour on {np} ranks ran: {rn.stderr if rn else ''}")
+if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    a, b = (json.load(open(os.path.join(d, "summary.json"))) for d in (q1, qn))
+    pa, pb = a["pours"][0], b["pours"][0]
+    check(pa["inserted"] == pb["inserted"] and pa["inserted"] > 100 and pa["inserted_kg"] == pb["inserted_kg"],
+          f"the pour inserts what one process inserts: {pa['inserted']} ({pa['inserted_kg']} kg) against "
+          f"{pb['inserted']} ({pb['inserted_kg']} kg)")
+    h1, p1 = probes(q1)
+    hn, pn = probes(qn)
+    ke = h1.index("column.ke_translational")
+    scale = max(row[ke] for row in p1)
+    worst = max(abs(x[ke] - y[ke]) / scale for x, y in zip(p1, pn))
+    check(all(x[1] == y[1] for x, y in zip(p1, pn)), "the same particle count in every probe row")
+    print(f"pour on {np} ranks: {pb['inserted']} particles in {pb['events']} events as on one process; kinetic "
+          f"energy within {worst:.3g} of one process's largest")
+    check(worst < 1e-6, f"the pour: kinetic energy within 1e-6 (found {worst:.3g})")
 
 # 5. the silo: pour, deletion and plane on the ranks
 if silo:
