@@ -155,9 +155,14 @@ void load_default_plugins(dp::PluginRegistry& registry) {
   for (const auto& r : registry.refused()) spdlog::warn("{}", r);
 }
 
+/// The problems a rank other than 0 found (main() prints them when rank 0
+/// did not end the run first: a problem of that rank alone, such as its part
+/// of a checkpoint).
+std::string g_deferred_problems;
+
 void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
-  if (world().rank() != 0) return;  // every rank read the same scenario: rank 0 says it once
-  std::fprintf(stderr, "domel: %s has %zu problem%s:\n", what.c_str(), diags.size(), diags.size() == 1 ? "" : "s");
+  std::string text = "domel: " + what + " has " + std::to_string(diags.size()) + " problem" +
+                     (diags.size() == 1 ? "" : "s") + ":\n";
   for (const auto& d : diags) {
     // a problem in another file (a checkpoint, a state file) names it
     const std::string in = !d.file.empty() && d.file != what ? d.file + ", " : "";
@@ -165,8 +170,11 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
                            ? "  - " + d.file + ": " + d.message
                            : "  - " + in + "at " + (d.pointer.empty() ? std::string("/") : d.pointer) + ": " + d.message;
     if (!d.hint.empty()) line += " (" + d.hint + ")";
-    std::fprintf(stderr, "%s\n", line.c_str());
+    text += line + "\n";
   }
+  // every rank read the same scenario: rank 0 says it once
+  if (world().rank() == 0) std::fputs(text.c_str(), stderr);
+  else g_deferred_problems = "(rank " + std::to_string(world().rank()) + ") " + text;
 }
 
 /// SIGINT and SIGTERM ask the run to stop after its current step
@@ -439,7 +447,11 @@ int main(int argc, char** argv) {
   // and wrote its checkpoint together: the ranks end normally.
   const bool stopped = code == 128 + SIGINT || code == 128 + SIGTERM;
   if (code != 0 && world().size() > 1 && !stopped) {
-    if (code == kExitRefused && world().rank() != 0) std::this_thread::sleep_for(std::chrono::seconds(1));
+    if (code == kExitRefused && world().rank() != 0) {
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+      // still here: rank 0 did not refuse the run, so the problem is this rank's own
+      if (!g_deferred_problems.empty()) std::fputs(g_deferred_problems.c_str(), stderr);
+    }
     world().abort(code);
   }
   return code;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "distributed/communicator.hpp"
 
+#include <cstdio>
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
@@ -136,6 +137,9 @@ MpiSession::MpiSession(int* argc, char*** argv, bool use) {
     // threads inside each rank; only the main thread calls MPI
     int provided = 0;
     check(MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+    if (provided < MPI_THREAD_FUNNELED)
+      std::fprintf(stderr, "domel: this MPI library does not support threads inside a rank (MPI_THREAD_FUNNELED); "
+                           "run with --threads 1\n");
     initialised_ = true;
   }
 #else

@@ -318,8 +318,15 @@ void GhostExchange::load(const ArchiveReader& r, const std::string& p, int ranks
   if (first.size() != n + 1 || counts.size() != n)
     r.fail(p + "first", "was written on " + std::to_string(counts.size()) + " ranks, not " + std::to_string(ranks));
   std::size_t total = 0;
-  for (auto c : counts) total += c;
+  for (auto c : counts) {
+    if (c > sent.size() - total) r.fail(p + "sent_counts", "counts more ghosts sent than the part holds");
+    total += c;
+  }
   if (sent.size() != total || shift.size() != 3 * total) r.fail(p + "sent", "does not match its counts");
+  for (std::size_t q = 0; q < n; ++q)
+    if (first[q + 1] < first[q]) r.fail(p + "first", "is not in ascending order");
+  for (std::uint32_t k : sent)
+    if (k >= first.front()) r.fail(p + "sent", "names a particle that is not one of the rank's own");
   first_.assign(first.begin(), first.end());
   sent_.assign(n, {});
   shift_.assign(n, {});

@@ -80,6 +80,8 @@ class GhostExchange {
   void reverse_counts(ParticleStore& s, const Communicator& comm) const;
   /// The owned count at the last build (the first ghost's index).
   std::size_t owned() const { return first_.empty() ? 0 : first_.front(); }
+  /// The store's size at the last build (the end of the ghosts).
+  std::size_t size() const { return first_.empty() ? 0 : first_.back(); }
   /// Bytes sent to other ranks by one update() and by one reverse().
   std::size_t update_bytes() const;
   std::size_t reverse_bytes() const;

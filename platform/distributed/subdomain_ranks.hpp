@@ -47,6 +47,8 @@ class SubdomainRanks final : public RankExchange {
   int size() const override { return comm_.size(); }
   void save(ArchiveWriter& w, const std::string& prefix) const override;
   void load(const ArchiveReader& r, const std::string& prefix) override;
+  std::size_t ghosts_begin() const override { return ghosts_.owned(); }
+  std::size_t ghosts_end() const override { return ghosts_.size(); }
 
   const Communicator& communicator() const { return comm_; }
   const Decomposition& decomposition() const { return d_; }

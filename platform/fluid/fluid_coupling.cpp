@@ -214,6 +214,7 @@ void FluidCoupling::write_fields(double t, bool final, const std::filesystem::pa
     os << spec_.where << ": the fluid coupler's fields failed at t = " << t << " s: " << e.what();
     throw RuntimeError(os.str());
   }
+  if (ranks_ && ranks_->rank() != 0) return;  // every rank asked the coupler alike (its state); rank 0 writes
   if (!fields_out_) fields_out_ = std::make_unique<io::FieldImageSeries>(out, "fluid");
   io::FieldImage image;
   image.cells = {f.nx, f.ny, f.nz};

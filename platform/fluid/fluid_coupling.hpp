@@ -80,7 +80,9 @@ class FluidCoupling {
   void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
 
   /// Write the coupler's fields when due (or, `final`, at the end whatever
-  /// the interval) into <out>/fluid_<NNNNNN>.vti and fluid.pvd.
+  /// the interval) into <out>/fluid_<NNNNNN>.vti and fluid.pvd. Spread over
+  /// ranks, every rank calls it (the coupler is asked alike everywhere) and
+  /// rank 0 writes.
   void write_fields(double t, bool final, const std::filesystem::path& out);
 
   /// Checkpoints (docs/checkpoint.md): the coupler's state (ABI 2.3

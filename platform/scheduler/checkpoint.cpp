@@ -224,8 +224,9 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
   ck.loop.probe_period = reals[1];
   ck.loop.vtk_period = reals[2];
   ck.loop.vtk_times = r.get<double>("loop/vtk_times");
-  const nlohmann::json ranks = ck.header.value("ranks", nlohmann::json(1));
-  if (!ranks.is_number_unsigned() || ranks.get<std::uint64_t>() < 1)
+  // "ranks" since checkpoints under MPI; earlier files were written by one process
+  const nlohmann::json ranks = ck.header.contains("ranks") ? ck.header["ranks"] : nlohmann::json(std::uint64_t{1});
+  if (!ranks.is_number_integer() || ranks.get<std::int64_t>() < 1 || ranks.get<std::int64_t>() > (1 << 24))
     r.fail("", "has a header whose \"ranks\" is not a positive count");
   ck.loop.ranks = ranks.get<int>();
   return ck;

@@ -141,6 +141,12 @@ void ParticleFlow::start(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
 }
 
 void ParticleFlow::update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+  if (ranks_) {
+    // the ghosts' contact counts go home before any rank edits its particles
+    // (an edit drops the ghosts; the outputs' gathers later in this macro
+    // step then find the counts collected). Collective, so on every rank.
+    for (auto& sd : subdomains) sd->collect_contact_counts();
+  }
   if (checks_.take(t)) {
     check_planes(subdomains);  // count crossings before the crossed particles are deleted
     delete_particles(subdomains);

@@ -498,9 +498,9 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     const ArchiveReader& r = *ck->archive;
     // the contact sample and files (sections absent when the checkpointed run had none)
     if (contact_sample.enabled() && r.has("contacts/time")) contact_sample.load(r, "contacts/");
-    if (contact_vtk && r.has("contacts/frames")) {
+    if (contact_framing && r.has("contacts/frames")) {  // the schedule on every rank: it decides a gather
       resume(contact_frames, r.scalar<std::uint64_t>("contacts/frames"), r.scalar<double>("contacts/period"));
-      contact_vtk->resume(r.get<double>("contacts/frame_times"));
+      if (contact_vtk) contact_vtk->resume(r.get<double>("contacts/frame_times"));
     }
     if (wall_vtk && r.has("walls/frame_times")) wall_vtk->resume(r.get<double>("walls/frame_times"));
     for (std::size_t g = 0; g < grids.size(); ++g) {
@@ -610,7 +610,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     }
     if (m > 0)
       for (auto& c : couplings) c->write_grids(t, false);
-    if (fluid && m < stop && writer) fluid->write_fields(t, false, out);
+    if (fluid && m < stop) fluid->write_fields(t, false, out);
     if (m == stop) break;
     if (options.time_after && m == options.time_after) window_start = std::chrono::steady_clock::now();
     // the contacts of the macro step's last steps, when an output at its end needs them
@@ -657,7 +657,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (probes) probes->flush();
   write_grids(static_cast<double>(m) * macro, true);
   for (auto& c : couplings) c->write_grids(static_cast<double>(m) * macro, true);
-  if (fluid && writer) fluid->write_fields(static_cast<double>(m) * macro, true, out);
+  if (fluid) fluid->write_fields(static_cast<double>(m) * macro, true, out);
 
   result.macro_steps = m;
   result.simulated_time = static_cast<double>(m) * macro;

@@ -51,6 +51,9 @@ class RankExchange {
   /// which ghosts) and the traffic counted so far. Not collective.
   virtual void save(ArchiveWriter& w, const std::string& prefix) const = 0;
   virtual void load(const ArchiveReader& r, const std::string& prefix) = 0;
+  /// Where the ghosts of the last build start and end in the store.
+  virtual std::size_t ghosts_begin() const = 0;
+  virtual std::size_t ghosts_end() const = 0;
 };
 
 }  // namespace domel::platform

@@ -17,6 +17,9 @@ namespace domel::platform {
 
 void Subdomain::save(ArchiveWriter& w, const std::string& p) {
   store();  // finishes the last step and counts the contacts
+  if (ranks_ && edited_)
+    throw RuntimeError("subdomain '" + name_ + "': a checkpoint between an edit of the particles and the next step "
+                       "(the ghosts are dropped, the lists name them) cannot be written");
   if (ranks_) {
     // this rank's part: its own particles, then its ghosts, and who holds which ghosts
     w.put(p + "rank", std::vector<std::uint64_t>{static_cast<std::uint64_t>(ranks_->rank()),
@@ -52,8 +55,11 @@ bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
     owned_ = own;
     ghosts_end_ = rank[3];
     edited_ = rank[4] != 0;
-    if (ghosts_end_ > store_.size()) r.fail(p + "rank", "counts more ghosts than the part holds");
+    if (owned_ > ghosts_end_ || ghosts_end_ != store_.size())
+      r.fail(p + "rank", "does not count the part's own particles and ghosts");
     ranks_->load(r, p + "exchange/");
+    if (ranks_->ghosts_begin() != owned_ || ranks_->ghosts_end() != ghosts_end_)
+      r.fail(p + "exchange/ghosts/first", "does not place the ghosts after the rank's own particles");
   }
   const auto pair_contacts = r.get<std::uint64_t>(p + "thread_pair_contacts");
   if (pair_contacts.size() != scratch_.size()) return false;  // the split is rebuilt at the next evaluation
@@ -94,7 +100,7 @@ void Subdomain::restore_shared_out(const std::vector<std::pair<const ArchiveRead
     std::vector<std::uint8_t> drop(store_.size());
     for (std::size_t k = 0; k < store_.size(); ++k) drop[k] = k >= own || store_.id[k] % n != me;
     store_.remove_marked(drop);
-    if (!kept) kept.emplace(std::move(store_));
+    if (!kept) kept.emplace(store_);  // a copy: the next part loads into store_ as configured (aux arrays)
     else kept->append(store_);
   }
   store_ = std::move(*kept);

@@ -52,6 +52,8 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR [SILO]
 9. The column on an STL mesh floor of 32 triangles (the box open at its
    bottom) for 3000 steps: the kinetic energy within 1e-6 of one process's
    largest, the same wall-contact count in every row.
+11. A deletion region without a mass-flow plane (the deleting ranks drop
+   their ghosts between the probes' gathers): the same particles removed.
 10. A pour across the rank borders (random fills into the box every 0.005 s,
    6 g in all) for 6000 steps (the first fills land by 0.03 s): the
    same particles and kg as one process, the same count in every probe row,
@@ -349,6 +351,25 @@ if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode ==
     frames1 = sorted(f for f in os.listdir(f1) if f.startswith("fluid_"))
     check(frames1 == sorted(f for f in os.listdir(fn) if f.startswith("fluid_")) and len(frames1) >= 1,
           "the same fluid frames")
+    # checkpointed at 1000 steps on NP ranks, restarted on another rank count (the coupler's per-particle
+    # arrays travel with the particles shared out anew)
+    with open(bed) as f:
+        doc = json.load(f)
+    doc["run"]["checkpoint_interval"] = 0.02
+    bed_ck = os.path.join(work, "bed_ck.json")
+    with open(bed_ck, "w") as f:
+        json.dump(doc, f)
+    fc = os.path.join(work, "bed_ck")
+    r = run(mpi + [domel, "run", bed_ck, "--out", fc, "--quiet", "--max-steps", "1000"])
+    check(r is not None and r.returncode == 0, "the checkpointed bed ran")
+    r = run(([mpiexec, "-np", str(other), "--oversubscribe"] if other > 1 else []) +
+            [domel, "run", bed_ck, "--out", fc, "--quiet", "--max-steps", "2000", "--restart",
+             os.path.join(fc, "checkpoint.ckpt")])
+    check(r is not None and r.returncode == 0, f"the bed restarted on {other} rank(s): {r.stderr if r else ''}")
+    if r is not None and r.returncode == 0:
+        hc, pc = probes(fc)
+        worst = max(abs(x[ke] - y[ke]) / scale for x, y in zip(pn, pc))
+        check(len(pc) >= 4 and worst < 1e-6, f"the restarted bed within 1e-6 of the uninterrupted run (found {worst:.3g})")
 
 # 9. a mesh wall across the ranks: the column settles on an STL floor of 32 triangles
 with open(scenario) as f:
@@ -387,6 +408,26 @@ if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode ==
     check(worst < 1e-6, f"the mesh floor: kinetic energy within 1e-6 (found {worst:.3g})")
     check(all(a[wc] == b[wc] for a, b in zip(p1, pn)) and p1[-1][wc] > 100,
           "the same wall contacts in every row, more than 100 at the end (the floor carries the column)")
+
+# 11. a deletion region without a mass-flow plane: the ranks that delete drop their ghosts before the
+# probes' gather (the ghosts' contact counts must have gone home first)
+with open(scenario) as f:
+    doc = json.load(f)
+doc["deletion_regions"] = [{"name": "low", "region": {"box": {"min": [0, 0, 0], "max": [0.02856, 0.02856, 0.01]}}}]
+doc["run"]["deletion_interval"] = 0.001
+doc["output"]["probe_interval"] = 0.0005
+deleting = os.path.join(work, "deletion.json")
+with open(deleting, "w") as f:
+    json.dump(doc, f)
+d1, dn = os.path.join(work, "deletion_one"), os.path.join(work, "deletion_ranks")
+r1 = run([domel, "run", deleting, "--out", d1, "--quiet", "--max-steps", "2000"])
+rn = run(mpi + [domel, "run", deleting, "--out", dn, "--quiet", "--max-steps", "2000"])
+check(r1 is not None and r1.returncode == 0 and rn is not None and rn.returncode == 0,
+      f"the deletion region ran: {rn.stderr if rn else ''}")
+if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    a, b = (json.load(open(os.path.join(d, "summary.json"))) for d in (d1, dn))
+    check(a["deletion_regions"]["low"]["removed"] == b["deletion_regions"]["low"]["removed"] > 0 and
+          a["particles"] == b["particles"], f"the same particles removed: {a['deletion_regions']} {b['deletion_regions']}")
 
 # 10. a pour across the rank borders: random fills into the box every 0.005 s
 with open(scenario) as f:
