@@ -119,7 +119,7 @@ std::size_t migrate_histories(const std::vector<PairHistories*>& sets,
       into.id_j.push_back(head[2]);
       const std::size_t old = into.values.size();
       into.values.resize(old + into.stride);
-      std::memcpy(into.values.data() + old, b.data() + at, bytes);
+      if (bytes > 0) std::memcpy(into.values.data() + old, b.data() + at, bytes);
       at += bytes;
     }
   for (std::size_t set = 0; set < sets.size(); ++set) *sets[set] = std::move(kept[set]);
@@ -276,6 +276,7 @@ void GhostExchange::reverse_counts(ParticleStore& s, const Communicator& comm) c
   std::vector<std::vector<char>> send(nr);
   for (std::size_t r = 0; r < nr; ++r) {
     const std::size_t n = first_[r + 1] - first_[r];
+    if (n == 0) continue;  // memcpy's pointers may not be null, even for no bytes
     send[r].resize(n * sizeof(std::uint32_t));
     std::memcpy(send[r].data(), s.contacts.data() + first_[r], send[r].size());
     std::fill_n(s.contacts.begin() + static_cast<std::ptrdiff_t>(first_[r]), n, 0u);
