@@ -161,4 +161,18 @@ void ParticleStore::append(const ParticleStore& other) {
   });
 }
 
+void ParticleStore::append(const ParticleStore& other, const std::vector<std::uint32_t>& which) {
+  if (other.external_force_ != external_force_ || other.aux.size() != aux.size())
+    throw std::invalid_argument("ParticleStore::append: the stores differ in external forces or aux arrays");
+  std::vector<const void*> from;
+  other.for_each_array([&](const auto& v) { from.push_back(&v); });
+  std::size_t k = 0;
+  for_each_array([&](auto& v) {
+    const auto& src = *static_cast<const std::remove_reference_t<decltype(v)>*>(from[k++]);
+    v.reserve(v.size() + which.size());
+    for (std::uint32_t q : which) v.push_back(src.at(q));
+  });
+  ++layout_version;
+}
+
 }  // namespace domel::platform

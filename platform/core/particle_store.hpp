@@ -102,6 +102,9 @@ struct ParticleStore {
   /// Append every particle of `other` (the same external-force switch and
   /// aux count: throws std::invalid_argument otherwise).
   void append(const ParticleStore& other);
+  /// Append the particles `which` of `other` (indices into it, in that order),
+  /// under the same conditions.
+  void append(const ParticleStore& other, const std::vector<std::uint32_t>& which);
 
   /// The order that sorts the particles by cubic cells of side `cell`, cell
   /// rows in z-y-x order (ties keep the current order): new index k holds

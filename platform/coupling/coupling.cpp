@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
+#include "scheduler/run_ranks.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -17,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 namespace domel::platform {
@@ -87,8 +89,13 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
                      const std::filesystem::path& out) {
   fine_grid_->set_accessible(walls, 0.0);
   coarse_grid_->set_accessible(walls, 0.0);
-  const ParticleStore& c = subdomains[spec_.coarse]->store();
-  const ParticleStore& f = subdomains[spec_.fine]->store();
+  std::optional<ParticleStore> all_c, all_f;
+  if (ranks_) {
+    all_c.emplace(ranks_->gather(*subdomains[spec_.coarse], true));
+    all_f.emplace(ranks_->gather(*subdomains[spec_.fine], true));
+  }
+  const ParticleStore& c = ranks_ ? *all_c : subdomains[spec_.coarse]->store();
+  const ParticleStore& f = ranks_ ? *all_f : subdomains[spec_.fine]->store();
   const double scale = subdomains[spec_.fine]->coarse_grain() / subdomains[spec_.coarse]->coarse_grain();
   for (double r : f.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r);
   for (double r : c.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r * scale);
@@ -125,9 +132,21 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
   ++since_transfer_;
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
-  remove_escaped(fine, flow);
-  count_inflow(coarse);
-  if (spec_.match_outflow) match_outflow(coarse, flow);
+  // the levels' whole sets of particles: on ranks, gathered (file comment)
+  std::optional<ParticleStore> all_f, all_c;
+  if (ranks_) {
+    all_f.emplace(ranks_->gather(fine, true));
+    all_c.emplace(ranks_->gather(coarse, true));
+  }
+  ParticleStore& f = ranks_ ? *all_f : fine.store();
+  ParticleStore& c = ranks_ ? *all_c : coarse.store();
+  std::vector<std::uint64_t> gone_f = remove_escaped(f, flow), gone_c;
+  count_inflow(c);
+  if (spec_.match_outflow) gone_c = match_outflow(c, coarse, flow);
+  if (ranks_) {
+    remove_own(fine, std::move(gone_f));
+    remove_own(coarse, std::move(gone_c));
+  }
   auto t1 = clock::now();
   timing_.count += std::chrono::duration<double>(t1 - t0).count();
   // Due at the longest interval, or earlier once what a face counted since
@@ -135,32 +154,40 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
   bool due = since_transfer_ >= spec_.transfer_controls;
   for (int face = 0; face < kFaces && !due; ++face)
     if (spec_.inflow[face]) due = faces_[face].volume_open >= spec_.fill_target * shell_volume(face);
-  if (due) transfer(t, fine, walls, flow);
+  if (due) transfer(t, fine, f, walls, flow);
   auto t2 = clock::now();
   timing_.transfer += std::chrono::duration<double>(t2 - t1).count();
-  control(t, interval, fine, coarse);
+  control(t, interval, fine, f, coarse, c);
   timing_.control += std::chrono::duration<double>(clock::now() - t2).count();
 }
 
-void Coupling::remove_escaped(Subdomain& fine, ParticleFlow& flow) {
-  ParticleStore& s = fine.store();
+void Coupling::remove_own(Subdomain& level, std::vector<std::uint64_t> ids) {
+  if (ids.empty()) return;
+  std::sort(ids.begin(), ids.end());
+  ParticleStore& s = level.particles_to_edit();
+  std::vector<std::uint8_t> mark(s.size(), 0);
+  for (std::size_t q = 0; q < s.size(); ++q) mark[q] = std::binary_search(ids.begin(), ids.end(), s.id[q]) ? 1 : 0;
+  s.remove_marked(mark);
+}
+
+std::vector<std::uint64_t> Coupling::remove_escaped(ParticleStore& s, ParticleFlow& flow) {
   const CellGridSpec& g = spec_.grid;
   std::vector<std::uint8_t> mark(s.size(), 0);
-  bool any = false;
+  std::vector<std::uint64_t> gone;
   for (std::size_t q = 0; q < s.size(); ++q) {
     const int face = face_beyond(g, s.x[q], s.y[q], s.z[q]);
     if (face < 0) continue;
     mark[q] = 1;
-    any = true;
+    gone.push_back(s.id[q]);
     faces_[face].removed += mass_units(s.mass[q]);
     ++faces_[face].n_removed;
     flow.count_removed(spec_.fine, s.id[q], s.mass[q]);
   }
-  if (any) s.remove_marked(mark);
+  if (!gone.empty()) s.remove_marked(mark);
+  return gone;
 }
 
-void Coupling::count_inflow(const Subdomain& coarse) {
-  const ParticleStore& s = coarse.store();
+void Coupling::count_inflow(const ParticleStore& s) {
   const CellGridSpec& g = spec_.grid;
   // Only parcels within one cell of the region are followed: one farther
   // away cannot cross a face before the next count unless it moves faster
@@ -236,7 +263,7 @@ void Coupling::count_inflow(const Subdomain& coarse) {
   coarse_last_.swap(now);
 }
 
-void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
+std::vector<std::uint64_t> Coupling::match_outflow(ParticleStore& s, const Subdomain& level, ParticleFlow& flow) {
   // the fine discharge: everything the fine level lost (its faces and its
   // deletion regions) but what left through an inflow face
   MassUnits fine_out = flow.accounts().at(spec_.fine).removed;
@@ -244,12 +271,11 @@ void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
     if (spec_.inflow[face]) fine_out -= faces_[face].removed;
   outflow_.fine = fine_out;
   double owed = outflow_.deficit();
-  if (owed <= 0) return;  // nothing owed: no scan (the coarse level leads or is level)
-  ParticleStore& s = coarse.store();
+  if (owed <= 0) return {};  // nothing owed: no scan (the coarse level leads or is level)
   double smallest = std::numeric_limits<double>::infinity();
   const CellGridSpec& g = spec_.grid;
   std::vector<std::pair<double, std::size_t>> inside;  // (height along -gravity, index)
-  const double* gr = coarse.body_forces().gravity;
+  const double* gr = level.body_forces().gravity;
   const double gn = std::sqrt(gr[0] * gr[0] + gr[1] * gr[1] + gr[2] * gr[2]);
   const double up[3] = {gn > 0 ? -gr[0] / gn : 0.0, gn > 0 ? -gr[1] / gn : 0.0, gn > 0 ? -gr[2] / gn : 1.0};
   for (std::size_t q = 0; q < s.size(); ++q) {
@@ -257,29 +283,30 @@ void Coupling::match_outflow(Subdomain& coarse, ParticleFlow& flow) {
     inside.emplace_back(up[0] * s.x[q] + up[1] * s.y[q] + up[2] * s.z[q], q);
     smallest = std::min(smallest, s.mass[q]);
   }
-  if (inside.empty() || owed < 0.5 * smallest) return;
+  if (inside.empty() || owed < 0.5 * smallest) return {};
   std::sort(inside.begin(), inside.end());
   std::vector<std::uint8_t> mark(s.size(), 0);
-  bool any = false;
+  std::vector<std::uint64_t> gone;
   // lowest first, each parcel removed while at least half its mass is owed:
   // the deficit then stays within half a parcel of zero
   for (const auto& [h, q] : inside) {
     if (owed < 0.5 * s.mass[q]) break;
     mark[q] = 1;
-    any = true;
+    gone.push_back(s.id[q]);
     outflow_.sink += mass_units(s.mass[q]);
     ++outflow_.n_sink;
     owed -= s.mass[q];
     coarse_last_.erase(s.id[q]);  // booked here, not again as a parcel that vanished
     flow.count_removed(spec_.coarse, s.id[q], s.mass[q]);
   }
-  if (any) s.remove_marked(mark);
+  if (!gone.empty()) s.remove_marked(mark);
+  return gone;
 }
 
-void Coupling::transfer(double t, Subdomain& fine, const std::vector<WallPrimitive>& walls, ParticleFlow& flow) {
+void Coupling::transfer(double t, Subdomain& level, ParticleStore& s, const std::vector<WallPrimitive>& walls,
+                        ParticleFlow& flow) {
   ++transfers_;
   since_transfer_ = 0;
-  ParticleStore& s = fine.store();
   const std::size_t first = s.size();
   for (int face = 0; face < kFaces; ++face) {
     if (!spec_.inflow[face]) continue;
@@ -300,7 +327,7 @@ void Coupling::transfer(double t, Subdomain& fine, const std::vector<WallPrimiti
     fb.volume_open = 0;
     fb.momentum[0] = fb.momentum[1] = fb.momentum[2] = 0;
     const std::size_t before = s.size();
-    insert_face(face, t, fine, walls, flow.next_id);
+    insert_face(face, t, s, walls, flow.next_id);
     for (std::size_t k = before; k < s.size(); ++k) {
       fb.inserted += mass_units(s.mass[k]);
       ++fb.n_inserted;
@@ -317,15 +344,27 @@ void Coupling::transfer(double t, Subdomain& fine, const std::vector<WallPrimiti
                    spec_.where, kFaceNames[face], fb.growing, backlog, t);
     }
   }
-  if (s.size() > first) fine.apply_body_forces(first, s.size());  // their first half kick sees their body forces
-  write_row(t, fine, flow);
+  // the new particles' first half kick sees their body forces; on ranks,
+  // each rank keeps those whose id falls to it
+  if (!ranks_) {
+    if (s.size() > first) level.apply_body_forces(first, s.size());
+  } else {
+    std::vector<std::uint32_t> mine;
+    for (std::size_t k = first; k < s.size(); ++k)
+      if (level.keeps(s.id[k])) mine.push_back(static_cast<std::uint32_t>(k));
+    if (!mine.empty()) {
+      ParticleStore& own = level.particles_to_edit();
+      own.append(s, mine);
+      level.apply_body_forces(own.size() - mine.size(), own.size());
+    }
+  }
+  write_row(t, s, flow);
 }
 
-std::size_t Coupling::insert_face(int face, double t, Subdomain& fine, const std::vector<WallPrimitive>& walls,
+std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const std::vector<WallPrimitive>& walls,
                                   std::uint64_t& next_id) {
   FaceBalance& fb = faces_[face];
   if (fb.queue.empty()) return 0;
-  ParticleStore& s = fine.store();
   const CellGridSpec& g = spec_.grid;
   double lo[3], hi[3];
   for (int a = 0; a < 3; ++a) lo[a] = g.lo[a], hi[a] = g.hi[a];
@@ -411,7 +450,8 @@ std::size_t Coupling::insert_face(int face, double t, Subdomain& fine, const std
   return placed;
 }
 
-void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& coarse) {
+void Coupling::control(double t, double interval, Subdomain& fine_level, ParticleStore& fine, Subdomain& coarse_level,
+                       ParticleStore& coarse) {
   if (!spec_.stress.enabled && !spec_.velocity.enabled) return;
   const CellFields& ff = fine_grid_->latest();
   const CellFields& fc = coarse_grid_->latest();
@@ -455,8 +495,7 @@ void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& co
   struct Forces {
     std::vector<double> x, y, z;
   } force_f, force_c;
-  auto particle_view = [&](Subdomain& sd, std::vector<std::uint32_t>& cell, Forces& force) {
-    ParticleStore& s = sd.store();
+  auto particle_view = [&](ParticleStore& s, std::vector<std::uint32_t>& cell, Forces& force) {
     const std::size_t n = s.size();
     cell.resize(n);
     for (std::size_t q = 0; q < n; ++q) {
@@ -468,8 +507,8 @@ void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& co
   };
   domel_particles_v1 pf = particle_view(fine, cell_f_, force_f);
   domel_particles_v1 pc = particle_view(coarse, cell_c_, force_c);
-  domel_level_v1 lf{sizeof(domel_level_v1), 0, fine.name().c_str(), fine.coarse_grain(), &gf, &pf};
-  domel_level_v1 lc{sizeof(domel_level_v1), 0, coarse.name().c_str(), coarse.coarse_grain(), &gc, &pc};
+  domel_level_v1 lf{sizeof(domel_level_v1), 0, fine_level.name().c_str(), fine_level.coarse_grain(), &gf, &pf};
+  domel_level_v1 lc{sizeof(domel_level_v1), 0, coarse_level.name().c_str(), coarse_level.coarse_grain(), &gc, &pc};
   domel_level_v1* levels[2] = {&lf, &lc};
   domel_control_step_v1 step{sizeof(domel_control_step_v1), 2, t, interval, levels};
   try {
@@ -478,18 +517,36 @@ void Coupling::control(double t, double interval, Subdomain& fine, Subdomain& co
   } catch (const PluginError& e) {
     throw RuntimeError(spec_.where + ": a controller failed at t = " + std::to_string(t) + " s: " + e.what());
   }
-  auto apply = [](ParticleStore& s, const Forces& f) {
-    for (std::size_t q = 0; q < s.size(); ++q) {
-      s.ext_fx[q] += f.x[q];
-      s.ext_fy[q] += f.y[q];
-      s.ext_fz[q] += f.z[q];
+  // Into the level's own particles: on one process the whole set is the
+  // store; on ranks it is the gathered set, in id order, and each rank adds
+  // the forces of its own particles, found by id.
+  auto apply = [this](Subdomain& level, const ParticleStore& whole, const Forces& f) {
+    if (!ranks_) {
+      ParticleStore& s = level.store();
+      for (std::size_t q = 0; q < s.size(); ++q) {
+        s.ext_fx[q] += f.x[q];
+        s.ext_fy[q] += f.y[q];
+        s.ext_fz[q] += f.z[q];
+      }
+      return;
+    }
+    ParticleStore& s = level.store();
+    for (std::size_t q = 0; q < level.owned(); ++q) {
+      const auto it = std::lower_bound(whole.id.begin(), whole.id.end(), s.id[q]);
+      if (it == whole.id.end() || *it != s.id[q])
+        throw RuntimeError(spec_.where + ": particle " + std::to_string(s.id[q]) + " of '" + level.name() +
+                           "' is missing from its level's gathered particles");
+      const auto k = static_cast<std::size_t>(it - whole.id.begin());
+      s.ext_fx[q] += f.x[k];
+      s.ext_fy[q] += f.y[k];
+      s.ext_fz[q] += f.z[k];
     }
   };
-  apply(fine.store(), force_f);
-  apply(coarse.store(), force_c);
+  apply(fine_level, fine, force_f);
+  apply(coarse_level, coarse, force_c);
 }
 
-void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& flow) {
+void Coupling::write_row(double t, const ParticleStore& s, const ParticleFlow& flow) {
   if (!balance_ || t <= last_row_t_) return;
   last_row_t_ = t;
   std::vector<double> row = {t};
@@ -506,7 +563,6 @@ void Coupling::write_row(double t, const Subdomain& fine, const ParticleFlow& fl
     row.push_back(mass_kg(fb.removed));
     at_faces += fb.removed;
   }
-  const ParticleStore& s = fine.store();
   MassUnits present = 0;
   for (double m : s.mass) present += mass_units(m);
   row.push_back(mass_kg(flow.accounts().at(spec_.fine).removed - at_faces));
@@ -645,10 +701,11 @@ void Coupling::load(const ArchiveReader& r, const std::string& p) {
   }
 }
 
-nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleFlow& flow) {
+nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleStore& all,
+                                 const ParticleFlow& flow) {
   const Subdomain& fine = *subdomains[spec_.fine];
   if (balance_) {
-    write_row(last_t_, fine, flow);
+    write_row(last_t_, all, flow);
     balance_->flush();
   }
   nlohmann::json faces = nlohmann::json::object();
@@ -675,7 +732,7 @@ nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& 
     faces[kFaceNames[face]] = j;
   }
   MassUnits present = 0;
-  for (double m : fine.store().mass) present += mass_units(m);
+  for (double m : all.mass) present += mass_units(m);
   return {{"coarse", subdomains[spec_.coarse]->name()},
           {"fine", fine.name()},
           {"control_interval_fine_steps", spec_.fine_steps},

@@ -26,6 +26,13 @@
 //      interval.
 // Nothing here reads a level's state from the future: every exchange runs
 // between macro steps, when all levels stand at the same time.
+//
+// Spread over MPI ranks (set_ranks), every rank gathers both levels'
+// particles in id order and runs the same exchange on them: the same books,
+// the same random draws, the same controller calls. Each rank then removes
+// its own particles among those removed, keeps the inserted particles whose
+// id falls to it (starts_on_rank, as a pour's) and adds the controllers'
+// forces to its own particles (docs/distributed.md).
 #pragma once
 
 #include "averaging/cell_grid.hpp"
@@ -52,6 +59,7 @@ namespace domel::platform {
 
 class ArchiveWriter;
 class ArchiveReader;
+class RunRanks;
 
 namespace io {
 class CsvSeries;
@@ -123,6 +131,8 @@ class Coupling {
   Coupling& operator=(const Coupling&) = delete;
 
   const CouplingSpec& spec() const { return spec_; }
+  /// Spread over these ranks (null: one process); before start().
+  void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
   /// The two levels' averages on the region's cells; the run loop samples
   /// them on the steps they are due (every control interval of each level).
   CellGrid& fine_grid() { return *fine_grid_; }
@@ -143,12 +153,13 @@ class Coupling {
   const Outflow& outflow() const { return outflow_; }
 
   /// Before the first step: accessible volumes, the coarse parcels' sides,
-  /// the balance file. `out` empty: no files.
+  /// the balance file. `out` empty: no files. Collective on ranks.
   void start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const std::vector<WallPrimitive>& walls,
              const std::filesystem::path& out);
   /// One control interval at time t (all levels stand at t): steps 1-4 of
   /// the file comment. External forces of both levels must have been zeroed
-  /// by the caller (several couplings add into the same level).
+  /// by the caller (several couplings add into the same level). Collective
+  /// on ranks.
   void exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains,
                 const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
   /// Grid files due at t (or the last ones when final).
@@ -164,8 +175,10 @@ class Coupling {
   /// checkpoint holds another coupling.
   void load(const ArchiveReader& r, const std::string& prefix);
 
-  /// Close the balance file and describe the coupling for summary.json.
-  nlohmann::json summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleFlow& flow);
+  /// Close the balance file and describe the coupling for summary.json;
+  /// `fine` holds all the fine level's particles (on ranks: gathered).
+  nlohmann::json summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleStore& fine,
+                         const ParticleFlow& flow);
 
   /// Wall time spent in the coupling so far [s], by part: removal and face
   /// counting, transfers (insertion), the controllers (views and calls),
@@ -181,17 +194,25 @@ class Coupling {
   double last_exchange_time() const { return last_t_; }
 
  private:
-  void remove_escaped(Subdomain& fine, ParticleFlow& flow);
-  void count_inflow(const Subdomain& coarse);
-  void match_outflow(Subdomain& coarse, ParticleFlow& flow);
-  void transfer(double t, Subdomain& fine, const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
-  std::size_t insert_face(int face, double t, Subdomain& fine, const std::vector<WallPrimitive>& walls,
+  // The steps work on a level's whole set of particles: its store on one
+  // process, its particles gathered from the ranks on several (see above);
+  // the removals return the ids removed, in store order.
+  std::vector<std::uint64_t> remove_escaped(ParticleStore& fine, ParticleFlow& flow);
+  void count_inflow(const ParticleStore& coarse);
+  std::vector<std::uint64_t> match_outflow(ParticleStore& coarse, const Subdomain& level, ParticleFlow& flow);
+  void transfer(double t, Subdomain& level, ParticleStore& fine, const std::vector<WallPrimitive>& walls,
+                ParticleFlow& flow);
+  std::size_t insert_face(int face, double t, ParticleStore& fine, const std::vector<WallPrimitive>& walls,
                           std::uint64_t& next_id);
-  void control(double t, double interval, Subdomain& fine, Subdomain& coarse);
-  void write_row(double t, const Subdomain& fine, const ParticleFlow& flow);
+  void control(double t, double interval, Subdomain& fine_level, ParticleStore& fine, Subdomain& coarse_level,
+               ParticleStore& coarse);
+  void write_row(double t, const ParticleStore& fine, const ParticleFlow& flow);
+  /// On ranks: remove this rank's own particles of `level` whose ids are in `ids`.
+  static void remove_own(Subdomain& level, std::vector<std::uint64_t> ids);
   double shell_volume(int face) const;
 
   CouplingSpec spec_;
+  RunRanks* ranks_ = nullptr;
   std::unique_ptr<CellGrid> fine_grid_, coarse_grid_;
   std::array<FaceBalance, kFaces> faces_;
   /// parcel id -> position and mass at the last count, for the parcels near the region

@@ -18,10 +18,6 @@
 namespace domel::platform {
 
 #ifdef DOMEL_HAVE_MPI
-struct Communicator::Impl {
-  MPI_Comm comm = MPI_COMM_WORLD;
-};
-
 namespace {
 void check(int rc, const char* what) {
   if (rc != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
@@ -33,6 +29,17 @@ bool mpi_running() {
   return init && !fin;
 }
 }  // namespace
+
+struct Communicator::Impl {
+  MPI_Comm comm = MPI_COMM_WORLD;
+  bool owned = false;  ///< made by split(): freed with the last copy
+  Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+  ~Impl() {
+    if (owned && mpi_running()) MPI_Comm_free(&comm);
+  }
+};
 #else
 struct Communicator::Impl {};
 #endif
@@ -56,6 +63,23 @@ Communicator Communicator::world() {
     check(MPI_Comm_size(impl->comm, &c.size_), "MPI_Comm_size");
     c.impl_ = std::move(impl);
   }
+#endif
+  return c;
+}
+
+Communicator Communicator::split(int colour) const {
+  Communicator c;
+#ifdef DOMEL_HAVE_MPI
+  if (impl_) {
+    auto impl = std::make_shared<Impl>();
+    check(MPI_Comm_split(impl_->comm, colour, rank_, &impl->comm), "MPI_Comm_split");
+    impl->owned = true;
+    check(MPI_Comm_rank(impl->comm, &c.rank_), "MPI_Comm_rank");
+    check(MPI_Comm_size(impl->comm, &c.size_), "MPI_Comm_size");
+    c.impl_ = std::move(impl);
+  }
+#else
+  (void)colour;
 #endif
   return c;
 }

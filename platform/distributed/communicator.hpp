@@ -24,6 +24,9 @@ class Communicator {
 
   int rank() const { return rank_; }
   int size() const { return size_; }
+  /// The ranks of this communicator that passed the same `colour`, in the
+  /// order they have here (MPI_Comm_split). Collective.
+  Communicator split(int colour) const;
 
   /// Element-wise sums over the ranks, in place. Integers: exact, so the
   /// result does not depend on how the values are spread over the ranks.

@@ -10,15 +10,23 @@
 
 namespace domel::platform {
 
-void MpiRunRanks::distribute(Subdomain& sd) {
-  // every rank built the same particles: keep every size-th by id (the first
-  // exchange moves each to the owner of its place)
+void MpiRunRanks::distribute(Subdomain& sd, int first, int count) {
+  // every rank built the same particles: each rank of the group keeps every
+  // count-th by id (the first exchange moves each to the owner of its
+  // place); the ranks outside keep none
+  const bool whole = count <= 0 || (first == 0 && count == comm_.size());
+  const bool member = whole || (comm_.rank() >= first && comm_.rank() < first + count);
+  const Communicator group = whole ? comm_ : comm_.split(member ? 0 : 1);
+  group_size_.emplace_back(&sd, whole ? comm_.size() : count);
   ParticleStore& s = sd.store();
-  const auto n = static_cast<std::uint64_t>(comm_.size()), me = static_cast<std::uint64_t>(comm_.rank());
   std::vector<std::uint8_t> other(s.size());
-  for (std::size_t k = 0; k < s.size(); ++k) other[k] = s.id[k] % n != me;
+  for (std::size_t k = 0; k < s.size(); ++k) other[k] = !member || !starts_on_rank(s.id[k], group.rank(), group.size());
   s.remove_marked(other);
-  spread_.emplace_back(&sd, &platform::distribute(sd, comm_));
+  if (!member) {
+    sd.set_elsewhere();
+    return;
+  }
+  spread_.emplace_back(&sd, &platform::distribute(sd, group));
 }
 
 nlohmann::json MpiRunRanks::traffic(const Subdomain& sd) {
@@ -28,7 +36,9 @@ nlohmann::json MpiRunRanks::traffic(const Subdomain& sd) {
   std::vector<std::uint64_t> v{t.migrations, t.migrated,  t.histories_sent, t.ghost_builds, t.ghosts,
                                t.updates,    t.update_bytes, t.reverses,   t.reverse_bytes};
   comm_.sum(v);
-  const auto ranks = static_cast<std::uint64_t>(comm_.size());
+  std::uint64_t ranks = 1;
+  for (const auto& [s, n] : group_size_)
+    if (s == &sd) ranks = static_cast<std::uint64_t>(n);
   return {{"list_builds", v[0] / ranks},
           {"particles_migrated", v[1]},
           {"contact_histories_migrated", v[2]},

@@ -17,7 +17,7 @@ class MpiRunRanks final : public RunRanks {
   explicit MpiRunRanks(Communicator comm) : comm_(std::move(comm)) {}
   int rank() const override { return comm_.rank(); }
   int size() const override { return comm_.size(); }
-  void distribute(Subdomain& sd) override;
+  void distribute(Subdomain& sd, int first = 0, int count = 0) override;
   ParticleStore gather(Subdomain& sd, bool everywhere = false) override;
   std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) override { return comm_.all_gather(mine); }
   std::vector<std::vector<char>> gather_to_root(const std::vector<char>& mine) override {
@@ -33,7 +33,8 @@ class MpiRunRanks final : public RunRanks {
 
  private:
   Communicator comm_;
-  std::vector<std::pair<const Subdomain*, const SubdomainRanks*>> spread_;  ///< distribute()'s exchanges
+  std::vector<std::pair<const Subdomain*, const SubdomainRanks*>> spread_;  ///< distribute()'s exchanges (here)
+  std::vector<std::pair<const Subdomain*, int>> group_size_;  ///< the ranks each subdomain was spread over
 };
 
 }  // namespace domel::platform

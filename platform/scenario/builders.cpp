@@ -1514,6 +1514,26 @@ void build_outputs(Build& b) {
     if (g.spec.write_interval < 0) g.spec.write_interval = sim.duration / 20.0;
 }
 
+/// subdomains[].rank_share: on every subdomain or on none.
+void build_rank_shares(Build& b) {
+  const json& sds = b.doc["subdomains"];
+  std::size_t given = 0, first_given = 0, first_missing = 0;
+  for (std::size_t k = sds.size(); k-- > 0;) {
+    if (member(sds[k], "rank_share")) ++given, first_given = k;
+    else first_missing = k;
+  }
+  if (given == 0) return;
+  if (given != sds.size()) {
+    b.ck.add(idx("/subdomains", first_missing),
+             "has no rank_share, while subdomain '" + sds[first_given]["name"].get<std::string>() + "' (" +
+                 idx("/subdomains", first_given) + "/rank_share) has one: the levels' rank groups need a share "
+                 "for every subdomain",
+             "give every subdomain a rank_share, or remove them all (every subdomain spread over all ranks)");
+    return;
+  }
+  for (const json& sd : sds) b.sim.rank_shares.push_back(sd["rank_share"].get<double>());
+}
+
 }  // namespace
 
 std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& file, PluginRegistry& registry) {
@@ -1525,6 +1545,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_run(b);
   scan_couplings(b);
   for (std::size_t k = 0; k < doc["subdomains"].size(); ++k) build_subdomain(b, k);
+  build_rank_shares(b);
   if (b.sim.subdomains.size() == doc["subdomains"].size()) build_couplings(b);
   build_particle_flow(b);
   if (b.ck.diags.empty()) warn_shared_space(b);

@@ -193,8 +193,7 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   std::size_t taken = 0, kept = 0;
   for (std::size_t q = 0; q < c.size() && p.inserted_mass < target; ++q) {
     const std::uint64_t id = next_id++;
-    const bool mine = !ranks_ || id % static_cast<std::uint64_t>(ranks_->size()) ==
-                                     static_cast<std::uint64_t>(ranks_->rank());
+    const bool mine = sd.keeps(id);
     if (mine && !st) st = &sd.particles_to_edit();
     ParticleStore& into = mine ? *st : elsewhere;
     into.add(id, c.x[q], c.y[q], c.z[q], c.r[q], p.materials.density_of(c, q), p.fixed, p.materials.material_of(c, q));

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -20,14 +22,57 @@ namespace domel::platform {
 
 class Subdomain;
 
+/// The levels' rank groups (subdomains[].rank_share): group k is the ranks
+/// [first, first + count), consecutive in the subdomains' order, sized in
+/// proportion to the shares (largest remainders, ties to the earlier
+/// subdomain), at least one rank each: `ranks` >= shares.size().
+struct RankGroup {
+  int first = 0, count = 0;
+};
+inline std::vector<RankGroup> rank_groups(const std::vector<double>& shares, int ranks) {
+  const std::size_t n = shares.size();
+  double total = 0;
+  for (double s : shares) total += s;
+  std::vector<int> c(n);
+  std::vector<double> rest(n);
+  int used = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double q = ranks * shares[k] / total;
+    c[k] = std::max(1, static_cast<int>(std::floor(q)));
+    rest[k] = q - std::floor(q);
+    used += c[k];
+  }
+  while (used < ranks) {  // the largest remainder first
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < n; ++k)
+      if (rest[k] > rest[best]) best = k;
+    ++c[best];
+    rest[best] = -1;
+    ++used;
+  }
+  while (used > ranks) {  // a group raised to one rank: the largest other gives one back
+    std::size_t big = 0;
+    for (std::size_t k = 1; k < n; ++k)
+      if (c[k] >= c[big]) big = k;
+    --c[big];
+    --used;
+  }
+  std::vector<RankGroup> g(n);
+  for (std::size_t k = 0, first = 0; k < n; first += static_cast<std::size_t>(c[k]), ++k)
+    g[k] = {static_cast<int>(first), c[k]};
+  return g;
+}
+
 class RunRanks {
  public:
   virtual ~RunRanks() = default;
   virtual int rank() const = 0;
   virtual int size() const = 0;
   /// Keep this rank's share of sd's particles and spread sd over the ranks
-  /// (before setup()). Collective.
-  virtual void distribute(Subdomain& sd) = 0;
+  /// [first, first + count) (count 0: all ranks); a rank outside the group
+  /// holds none of sd (Subdomain::set_elsewhere). Before setup().
+  /// Collective over all ranks.
+  virtual void distribute(Subdomain& sd, int first = 0, int count = 0) = 0;
   /// The particles every rank owns of sd, in id order, on rank 0 (on the
   /// others: empty), or with `everywhere` on every rank. Collective.
   virtual ParticleStore gather(Subdomain& sd, bool everywhere = false) = 0;

@@ -145,27 +145,26 @@ std::string Simulation::why_no_checkpoint() const {
                                 "docs/sdk-guide.md), so this run cannot be checkpointed";
 }
 
-std::vector<Diagnostic> Simulation::not_distributable() const {
-  std::vector<Diagnostic> out;
-  const std::string file = scenario_file.string();
-  auto refuse = [&](const std::string& pointer, const std::string& what) {
-    out.push_back({file, pointer, what + " cannot run spread over MPI ranks yet (docs/distributed.md)",
-                   "run it as one process: domel run without mpirun"});
-  };
-  if (!couplings.empty()) refuse("/couplings", "a coupling between levels");
-  return out;
-}
-
 RunResult Simulation::run(const RunOptions& options, const PluginRegistry& registry) {
   RunResult result;
   // Spread over ranks: every rank runs this function on the same scenario;
   // rank 0 alone writes files and reports (scheduler/run_ranks.hpp).
   RunRanks* const ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
   const bool writer = ranks == nullptr || ranks->rank() == 0;
-  if (ranks) {
-    std::vector<Diagnostic> refused = not_distributable();
-    if (!refused.empty()) throw ConfigError(refused);
+  // Levels on rank groups (subdomains[].rank_share), checked before anything is written.
+  std::vector<RankGroup> groups;
+  if (ranks && !rank_shares.empty()) {
+    if (static_cast<std::size_t>(ranks->size()) < subdomains.size())
+      throw ConfigError({Diagnostic{scenario_file.string(), "/subdomains/0/rank_share",
+                                    "the subdomains run on rank groups of their own (rank_share), which needs a rank "
+                                    "for each of the " + std::to_string(subdomains.size()) + " subdomains; mpirun "
+                                    "started " + std::to_string(ranks->size()),
+                                    "run on at least " + std::to_string(subdomains.size()) + " ranks (mpirun -np " +
+                                        std::to_string(subdomains.size()) + "), or remove every rank_share"}});
+    groups = rank_groups(rank_shares, ranks->size());
   }
+  if (!ranks && !rank_shares.empty())
+    spdlog::info("one process: the subdomains' rank_share apply to runs under mpirun only");
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
   // A restart is checked against this scenario before anything is written.
@@ -203,26 +202,32 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     substeps.push_back(n);
     sd->set_threads(threads_requested);
     sd->set_record_contacts(!ck && contact_sample.enabled());  // the outputs at t = 0 (wall loads, contacts)
-    if (ranks) ranks->distribute(*sd);
+    if (ranks) {
+      const std::size_t k = substeps.size() - 1;
+      if (groups.empty()) {
+        ranks->distribute(*sd);
+      } else {
+        ranks->distribute(*sd, groups[k].first, groups[k].count);
+        if (writer)
+          spdlog::info("subdomain '{}' on rank{} {}{}", sd->name(), groups[k].count > 1 ? "s" : "", groups[k].first,
+                       groups[k].count > 1 ? "-" + std::to_string(groups[k].first + groups[k].count - 1) : "");
+      }
+    }
     if (!ck) sd->setup();
   }
   // Wall loads and contact rows from subdomain k's recorded contacts; spread
   // over ranks, from every rank's particles and records, gathered on every
   // rank (the same sums everywhere: a servo moves its wall alike on all).
-  auto take_contact_sample = [&](std::size_t k, const ParticleStore* all,
-                                 const std::vector<ContactRecord>* gathered) {
-    Subdomain& sd = *subdomains[k];
-    if (!ranks) return contact_sample.take(k, sd, walls);
-    std::optional<ParticleStore> mine;
-    if (!all) all = &mine.emplace(ranks->gather(sd, true));
-    std::optional<std::vector<ContactRecord>> records;
-    if (!gathered) gathered = &records.emplace(gather_contact_records(*ranks, sd, *all));
-    contact_sample.take(k, sd, *all, {gathered}, walls);
-  };
   if (!ck && contact_sample.enabled()) {
     contact_sample.begin(0.0);
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
-      take_contact_sample(k, nullptr, nullptr);
+      if (!ranks) {
+        contact_sample.take(k, *subdomains[k], walls);
+      } else {
+        const ParticleStore all = ranks->gather(*subdomains[k], true);
+        const std::vector<ContactRecord> records = gather_contact_records(*ranks, *subdomains[k], all);
+        contact_sample.take(k, *subdomains[k], all, {&records}, walls);
+      }
       subdomains[k]->set_record_contacts(false);
     }
   }
@@ -287,7 +292,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   std::vector<Sampler> samplers;
   for (std::size_t g = 0; g < grids.size(); ++g) samplers.push_back({grids[g].get(), grid_setups[g].subdomain, nullptr});
   for (auto& c : couplings) {
-    c->start(subdomains, walls, out);
+    c->set_ranks(ranks);
+    c->start(subdomains, walls, writer ? out : std::filesystem::path());
     samplers.push_back({&c->fine_grid(), c->spec().fine, &c->timing().averaging});
     samplers.push_back({&c->coarse_grid(), c->spec().coarse, &c->timing().averaging});
   }
@@ -307,9 +313,13 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       if (due || for_outputs) {
         const ParticleStore all = ranks->gather(sd, true);
         const std::vector<ContactRecord> records = gather_contact_records(*ranks, sd, all);
-        for (const auto& s : samplers)
-          if (s.subdomain == k && s.grid->due(sd.steps())) s.grid->sample(all, {&records}, sd.time());
-        if (for_outputs) take_contact_sample(k, &all, &records);
+        for (const auto& s : samplers) {
+          if (s.subdomain != k || !s.grid->due(sd.steps())) continue;
+          const auto t0 = std::chrono::steady_clock::now();
+          s.grid->sample(all, {&records}, sd.time());
+          if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        }
+        if (for_outputs) contact_sample.take(k, sd, all, {&records}, walls);
       }
       sd.set_record_contacts(false);
       return;
@@ -706,6 +716,9 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     const auto& sd = subdomains[k];
     const SubdomainStats st = stats_of(k, result.simulated_time);
     const nlohmann::json traffic = ranks ? ranks->traffic(*sd) : nlohmann::json();
+    // the same on every rank of the subdomain's group, none elsewhere
+    const auto builds = static_cast<std::uint64_t>(
+        ranks ? ranks->max(static_cast<double>(sd->neighbor_builds())) : static_cast<double>(sd->neighbor_builds()));
     MemoryUse mem = sd->memory_use();
     if (ranks) {  // over all ranks
       std::vector<std::uint64_t> b{mem.particles, mem.neighbor_lists, mem.contact_history, mem.threads};
@@ -724,7 +737,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                    {"contact_time_s", time_steps[k].contact_time},
                    {"stability_limit_s", time_steps[k].critical},
                    {"steps", sd->steps()},
-                   {"neighbor_list_builds", sd->neighbor_builds()},
+                   {"neighbor_list_builds", builds},
                    {"memory_bytes", {{"particles", mem.particles},
                                      {"neighbor_lists", mem.neighbor_lists},
                                      {"contact_history", mem.contact_history},
@@ -738,6 +751,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
                               {"contacts", st.contacts},
                               {"wall_contacts", st.wall_contacts}}}});
     if (ranks) sds.back()["ranks_exchange"] = traffic;
+    if (!groups.empty()) sds.back()["rank_group"] = {{"first", groups[k].first}, {"count", groups[k].count}};
   }
   auto at_end = [&](std::size_t k) -> const ParticleStore& { return particles_of(k, result.simulated_time); };
   if (repose_probe) {
@@ -760,7 +774,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (!couplings.empty()) {
     nlohmann::json cj = nlohmann::json::object();
     for (auto& c : couplings) {
-      cj[c->spec().name] = c->summary(subdomains, flow);
+      cj[c->spec().name] = c->summary(subdomains, at_end(c->spec().fine), flow);
       if (c->spec().grid_interval > 0)
         files["couplings"][c->spec().name] = {{"balance", c->spec().name + "_balance.csv"},
                                               {"fine_grid", c->spec().name + "_fine.pvd"},

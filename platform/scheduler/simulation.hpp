@@ -81,6 +81,9 @@ class Simulation {
   std::vector<WallPrimitive> walls;    ///< the scenario walls' primitives at time 0
   std::vector<std::string> wall_names;  ///< the scenario walls (WallPrimitive::wall indexes it)
   std::vector<std::unique_ptr<Subdomain>> subdomains;
+  /// subdomains[].rank_share, one per subdomain, or empty: every subdomain
+  /// spread over all ranks (rank_groups()).
+  std::vector<double> rank_shares;
   std::vector<TimeStepReport> time_steps;  ///< per subdomain
   double gravity[3] = {0, 0, 0};  ///< [m/s^2] the scenario's at t = 0 (its schema default when omitted)
   std::shared_ptr<const GravitySchedule> gravity_schedule;  ///< the scenario's gravity over time (core/gravity.hpp)
@@ -134,10 +137,6 @@ class Simulation {
 
   /// The macro step and each subdomain's number of sub-steps within it.
   double macro_step() const;
-
-  /// What a run spread over several ranks cannot do yet (docs/distributed.md):
-  /// one diagnostic per part of the scenario, with its JSON pointer.
-  std::vector<Diagnostic> not_distributable() const;
 };
 
 }  // namespace domel::platform

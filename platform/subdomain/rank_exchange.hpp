@@ -21,6 +21,13 @@
 
 namespace domel::platform {
 
+/// The rank that keeps a particle every rank created alike (the particles at
+/// a start, a pour's, an inflow's, a checkpoint's on another rank count): id
+/// modulo the rank count. The next exchange moves it to the owner of its place.
+inline bool starts_on_rank(std::uint64_t id, int rank, int ranks) {
+  return id % static_cast<std::uint64_t>(ranks) == static_cast<std::uint64_t>(rank);
+}
+
 class RankExchange {
  public:
   virtual ~RankExchange() = default;

@@ -105,6 +105,18 @@ class Subdomain {
   /// distributed (what is added or removed is this rank's own; the next step
   /// rebuilds the lists on every rank and moves each particle to its owner).
   ParticleStore& particles_to_edit();
+  /// This subdomain lives on other ranks (levels on rank groups,
+  /// docs/distributed.md): this rank holds none of its particles, steps it
+  /// empty (its clock still runs) and keeps none of those created alike.
+  /// Before setup(), with an empty store.
+  void set_elsewhere() { elsewhere_ = true; }
+  bool elsewhere() const { return elsewhere_; }
+  /// Whether this rank keeps a particle every rank created alike (a pour's,
+  /// an inflow's, a checkpoint's shared out anew): always on one process;
+  /// spread over ranks, the rank starts_on_rank() names.
+  bool keeps(std::uint64_t id) const {
+    return !elsewhere_ && (!ranks_ || starts_on_rank(id, ranks_->rank(), ranks_->size()));
+  }
   /// Re-order the store by spatial cells every `builds` neighbour-list
   /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
   void set_reorder_every(std::size_t builds) { reorder_every_ = builds; }
@@ -316,6 +328,7 @@ class Subdomain {
   std::size_t owned_ = 0;                ///< distributed: the owned particles, ghosts after them
   std::size_t ghosts_end_ = 0;           ///< distributed: the store's size after the ghosts were built
   bool edited_ = false;                  ///< distributed: particles_to_edit() dropped the ghosts
+  bool elsewhere_ = false;               ///< set_elsewhere()
 };
 
 }  // namespace domel::platform

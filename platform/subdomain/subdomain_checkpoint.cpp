@@ -76,15 +76,13 @@ void Subdomain::restore_shared_out(const std::vector<std::pair<const ArchiveRead
   // are built anew, carrying the histories over by ids. The forces are the
   // checkpoint's (complete on their owners), so the next step goes on from
   // the saved state.
-  const std::uint64_t me = ranks_ ? static_cast<std::uint64_t>(ranks_->rank()) : 0;
-  const std::uint64_t n = ranks_ ? static_cast<std::uint64_t>(ranks_->size()) : 1;
   const uint32_t stride = pipeline_->history_stride();
   std::optional<ParticleStore> kept;
   std::vector<PairHistories> h(1 + wall_lists_.size());
   for (auto& set : h) set.stride = stride;
   auto take_rows = [&](PairHistories& into, const PairHistories& from) {
     for (std::size_t k = 0; k < from.size(); ++k) {
-      if (from.id_i[k] % n != me) continue;
+      if (!keeps(from.id_i[k])) continue;
       into.id_i.push_back(from.id_i[k]);
       into.id_j.push_back(from.id_j[k]);
       into.values.insert(into.values.end(), from.values.begin() + static_cast<std::ptrdiff_t>(k * stride),
@@ -98,7 +96,7 @@ void Subdomain::restore_shared_out(const std::vector<std::pair<const ArchiveRead
     take_rows(h[0], nlist_.live_histories());
     for (std::size_t w = 0; w < wall_lists_.size(); ++w) take_rows(h[1 + w], wall_lists_[w].live_histories(stride));
     std::vector<std::uint8_t> drop(store_.size());
-    for (std::size_t k = 0; k < store_.size(); ++k) drop[k] = k >= own || store_.id[k] % n != me;
+    for (std::size_t k = 0; k < store_.size(); ++k) drop[k] = k >= own || !keeps(store_.id[k]);
     store_.remove_marked(drop);
     if (!kept) kept.emplace(store_);  // a copy: the next part loads into store_ as configured (aux arrays)
     else kept->append(store_);

@@ -71,7 +71,7 @@ Run prepared(const json& doc, bool stirred, const dp::Communicator* comm, double
   if (comm) {
     std::vector<std::uint8_t> other(s.size());
     for (std::size_t k = 0; k < s.size(); ++k)
-      other[k] = s.id[k] % static_cast<std::uint64_t>(comm->size()) != static_cast<std::uint64_t>(comm->rank());
+      other[k] = !dp::starts_on_rank(s.id[k], comm->rank(), comm->size());
     s.remove_marked(other);
     r.ranks = &dp::distribute(sd, *comm);
   }
@@ -212,7 +212,7 @@ double head_on_restitution(const dp::Communicator* comm, double& dt_used, std::s
   if (comm) {
     std::vector<std::uint8_t> other(s.size());
     for (std::size_t k = 0; k < s.size(); ++k)
-      other[k] = s.id[k] % static_cast<std::uint64_t>(comm->size()) != static_cast<std::uint64_t>(comm->rank());
+      other[k] = !dp::starts_on_rank(s.id[k], comm->rank(), comm->size());
     s.remove_marked(other);
     dp::distribute(sd, *comm);
   }

@@ -17,8 +17,10 @@ Without SILO, cases 1-4 and 6-11; with SILO, case 5 alone.
    measured at most 1e-8 on 2-4 ranks); run again on NP ranks, probes.csv
    and the last particle frame are the same bytes (reproducible for a given
    rank count).
-2. A scenario the distributed run cannot do yet (silo_ci_2lvl: a coupling between levels) is refused
-   with its JSON pointer, on every rank, non-zero exit, nothing written.
+2. A scenario whose levels' rank groups are half given (silo_ci_2lvl with a
+   rank_share on its first subdomain only) is refused with the JSON pointer
+   of the other, on every rank, non-zero exit, rank 0 alone reporting it,
+   nothing written.
 3. A failure on rank 0 alone (its output folder holds an earlier run) ends
    every rank with a non-zero exit and that rank's message, never a hang;
    so does a run that blows up (a time step 4 times the stability limit,
@@ -95,6 +97,24 @@ def run(cmd, timeout=240):
         return None
 
 
+def write_scenario(doc, name):
+    path = os.path.join(work, name + ".json")
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    return path
+
+
+def one_and_ranks(path, name, steps):
+    """Run `path` for `steps` steps on one process and on the NP ranks; the two folders when both ran, else None."""
+    o1, on = os.path.join(work, name + "_one"), os.path.join(work, name + "_ranks")
+    r1 = run([domel, "run", path, "--out", o1, "--quiet", "--max-steps", str(steps)])
+    rn = run(mpi + [domel, "run", path, "--out", on, "--quiet", "--max-steps", str(steps)])
+    ok1, okn = r1 is not None and r1.returncode == 0, rn is not None and rn.returncode == 0
+    check(ok1, f"{name} on one process ran: {r1.stderr[-600:] if r1 else ''}")
+    check(okn, f"{name} on {np} ranks ran: {rn.stderr[-600:] if rn else ''}")
+    return (o1, on) if ok1 and okn else None
+
+
 def probes(folder):
     with open(os.path.join(folder, "probes.csv")) as f:
         head = f.readline().strip().split(",")
@@ -161,13 +181,18 @@ if not silo:
               "one set of files")
 
     # 2. refused on every rank, nothing written
-    refused_scenario = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(scenario))), "silo",
-                                    "silo_ci_2lvl.json")
+    with open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(scenario))), "silo",
+                           "silo_ci_2lvl.json")) as f:
+        doc = json.load(f)
+    doc["subdomains"][0]["rank_share"] = 1
+    refused_scenario = os.path.join(work, "half_groups.json")
+    with open(refused_scenario, "w") as f:
+        json.dump(doc, f)
     refused_out = os.path.join(work, "refused")
     r = run(mpi + [domel, "run", refused_scenario, "--out", refused_out, "--quiet"])
     if r is not None:
-        check(r.returncode != 0, "a coupling between levels under mpirun is refused")
-        check("/couplings" in r.stderr and "MPI ranks" in r.stderr, "the refusal names the pointer: " + r.stderr)
+        check(r.returncode != 0, "half-given rank groups under mpirun are refused")
+        check("/subdomains/1" in r.stderr and "rank_share" in r.stderr, "the refusal names the pointer: " + r.stderr)
         check(r.stderr.count("nothing was run") == 1, "rank 0 alone reports it")
         check(not os.path.exists(os.path.join(refused_out, "summary.json")), "nothing written")
 
@@ -193,11 +218,9 @@ if not silo:
 
     # 4. the shaker: moving walls, materials, region-mass probes
     shaker = os.path.join(os.path.dirname(os.path.abspath(scenario)), "shaker.json")
-    o1, on = os.path.join(work, "shaker_one"), os.path.join(work, "shaker_ranks")
-    r1 = run([domel, "run", shaker, "--out", o1, "--quiet", "--max-steps", "8000"])
-    rn = run(mpi + [domel, "run", shaker, "--out", on, "--quiet", "--max-steps", "8000"])
-    check(r1 is not None and r1.returncode == 0 and rn is not None and rn.returncode == 0, "the shaker ran")
-    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    folders = one_and_ranks(shaker, "shaker", 8000)
+    if folders:
+        o1, on = folders
         h1, p1 = probes(o1)
         hn, pn = probes(on)
         check(h1 == hn and len(p1) == len(pn) and len(p1) > 3, "the shaker's probe columns and rows")
@@ -218,15 +241,9 @@ if not silo:
                          "motion": {"servo": {"direction": [0, 0, -1], "force": 0.2, "max_velocity": 0.2}}})
     doc["output"]["wall_loads"] = [{"wall": "box"}, {"wall": "lid"}]
     doc["output"]["contacts"] = {"interval": 0.0025}
-    loaded = os.path.join(work, "loads.json")
-    with open(loaded, "w") as f:
-        json.dump(doc, f)
-    o1, on = os.path.join(work, "loads_one"), os.path.join(work, "loads_ranks")
-    r1 = run([domel, "run", loaded, "--out", o1, "--quiet", "--max-steps", "1000"])
-    rn = run(mpi + [domel, "run", loaded, "--out", on, "--quiet", "--max-steps", "1000"])
-    check(r1 is not None and r1.returncode == 0, "wall loads on one process ran")
-    check(rn is not None and rn.returncode == 0, f"wall loads on {np} ranks ran: {rn.stderr if rn else ''}")
-    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    folders = one_and_ranks(write_scenario(doc, "loads"), "loads", 1000)
+    if folders:
+        o1, on = folders
         h1, p1 = probes(o1)
         hn, pn = probes(on)
         check(h1 == hn and len(p1) == len(pn), "the same probe columns and rows")
@@ -332,12 +349,9 @@ if not silo:
 
     # 8. the fluid coupling: a gas-fluidised bed (scenarios/fluid/bed/a4.json, 619 parcels, the vans coupler)
     bed = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(scenario))), "fluid", "bed", "a4.json")
-    f1, fn = os.path.join(work, "bed_one"), os.path.join(work, "bed_ranks")
-    r1 = run([domel, "run", bed, "--out", f1, "--quiet", "--max-steps", "5000"])
-    rn = run(mpi + [domel, "run", bed, "--out", fn, "--quiet", "--max-steps", "5000"])
-    check(r1 is not None and r1.returncode == 0, "the fluidised bed on one process ran")
-    check(rn is not None and rn.returncode == 0, f"the fluidised bed on {np} ranks ran: {rn.stderr if rn else ''}")
-    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    folders = one_and_ranks(bed, "bed", 5000)
+    if folders:
+        f1, fn = folders
         h1, p1 = probes(f1)
         hn, pn = probes(fn)
         check(h1 == hn and len(p1) == len(pn) and len(p1) >= 10, "the bed's probe rows")
@@ -392,15 +406,9 @@ if not silo:
         f.write("endsolid floor\n")
     doc["walls"][0]["open"] = ["zmin", "zmax"]
     doc["walls"].append({"name": "floor", "type": "mesh", "material": "beads", "file": "floor.stl"})
-    meshed = os.path.join(work, "mesh_floor.json")
-    with open(meshed, "w") as f:
-        json.dump(doc, f)
-    m1, mn = os.path.join(work, "mesh_one"), os.path.join(work, "mesh_ranks")
-    r1 = run([domel, "run", meshed, "--out", m1, "--quiet", "--max-steps", "3000"])
-    rn = run(mpi + [domel, "run", meshed, "--out", mn, "--quiet", "--max-steps", "3000"])
-    check(r1 is not None and r1.returncode == 0, "the mesh floor on one process ran")
-    check(rn is not None and rn.returncode == 0, f"the mesh floor on {np} ranks ran: {rn.stderr if rn else ''}")
-    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    folders = one_and_ranks(write_scenario(doc, "mesh_floor"), "mesh", 3000)  # floor.stl beside it
+    if folders:
+        m1, mn = folders
         h1, p1 = probes(m1)
         hn, pn = probes(mn)
         ke, wc = h1.index("column.ke_translational"), h1.index("column.wall_contacts")
@@ -420,15 +428,9 @@ if not silo:
     doc["deletion_regions"] = [{"name": "low", "region": {"box": {"min": [0, 0, 0], "max": [0.02856, 0.02856, 0.01]}}}]
     doc["run"]["deletion_interval"] = 0.001
     doc["output"]["probe_interval"] = 0.0005
-    deleting = os.path.join(work, "deletion.json")
-    with open(deleting, "w") as f:
-        json.dump(doc, f)
-    d1, dn = os.path.join(work, "deletion_one"), os.path.join(work, "deletion_ranks")
-    r1 = run([domel, "run", deleting, "--out", d1, "--quiet", "--max-steps", "2000"])
-    rn = run(mpi + [domel, "run", deleting, "--out", dn, "--quiet", "--max-steps", "2000"])
-    check(r1 is not None and r1.returncode == 0 and rn is not None and rn.returncode == 0,
-          f"the deletion region ran: {rn.stderr if rn else ''}")
-    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    folders = one_and_ranks(write_scenario(doc, "deletion"), "deletion", 2000)
+    if folders:
+        d1, dn = folders
         a, b = (json.load(open(os.path.join(d, "summary.json"))) for d in (d1, dn))
         check(a["deletion_regions"]["low"]["removed"] == b["deletion_regions"]["low"]["removed"] > 0 and
               a["particles"] == b["particles"], f"the same particles removed: {a['deletion_regions']} {b['deletion_regions']}")
@@ -441,15 +443,9 @@ if not silo:
     sd["pour"] = [{"insert": {"model": "random", "diameter": 0.0028, "volume_fraction": 0.05,
                               "region": {"box": {"min": [0, 0, 0.005], "max": [0.02856, 0.02856, 0.035]}}},
                     "mass_rate": 0.2, "total_mass": 0.006, "interval": 0.005}]
-    poured = os.path.join(work, "pour.json")
-    with open(poured, "w") as f:
-        json.dump(doc, f)
-    q1, qn = os.path.join(work, "pour_one"), os.path.join(work, "pour_ranks")
-    r1 = run([domel, "run", poured, "--out", q1, "--quiet", "--max-steps", "6000"])
-    rn = run(mpi + [domel, "run", poured, "--out", qn, "--quiet", "--max-steps", "6000"])
-    check(r1 is not None and r1.returncode == 0, f"the pour on one process ran: {r1.stderr if r1 else ''}")
-    check(rn is not None and rn.returncode == 0, f"the pour on {np} ranks ran: {rn.stderr if rn else ''}")
-    if r1 is not None and rn is not None and r1.returncode == 0 and rn.returncode == 0:
+    folders = one_and_ranks(write_scenario(doc, "pour"), "pour", 6000)
+    if folders:
+        q1, qn = folders
         a, b = (json.load(open(os.path.join(d, "summary.json"))) for d in (q1, qn))
         pa, pb = a["pours"][0], b["pours"][0]
         check(pa["inserted"] == pb["inserted"] and pa["inserted"] > 100 and pa["inserted_kg"] == pb["inserted_kg"],
