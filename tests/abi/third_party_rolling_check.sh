@@ -13,7 +13,7 @@
 #    options that make it LIGGGHTS epsd2 (Iwashita-Oda stiffness, no dashpot),
 #    and for a copy in which the material pair names epsd
 #    (interactions[].rolling) and the subdomain has no rolling model;
-# 3b. with an MPI build and mpirun: the scenario for 6000 steps on 2 and 3
+# 3b. with an MPI build and mpirun: the scenario for 6000 steps on 2, 3 and 4
 #    ranks (the plugin loaded on every rank, never told of the ranks) within
 #    1e-6 of one process's largest kinetic energy (round-off);
 # 4. `domel validate` on a copy with a misspelt epsd parameter: exit code 2
@@ -107,11 +107,11 @@ sys.exit(1 if errors else 0)
 EOF
 done
 
-echo "== 3b. the same plugin in a run spread over 2 and 3 MPI ranks (mpirun), against one process"
+echo "== 3b. the same plugin in a run spread over 2, 3 and 4 MPI ranks (mpirun), against one process"
 if command -v mpirun >/dev/null && ldd "$domel" | grep -q libmpi; then
   "$domel" run "$tmp/build/scenario.json" --out "$tmp/out_one" --quiet --max-steps 6000 >"$tmp/run.log" 2>&1 ||
     { cat "$tmp/run.log" >&2; fail "domel run (6000 steps) failed"; }
-  for np in 2 3; do
+  for np in 2 3 4; do
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader \
       timeout 300 mpirun -np $np --oversubscribe "$domel" run "$tmp/build/scenario.json" --out "$tmp/out_np$np" \
       --quiet --max-steps 6000 >"$tmp/run.log" 2>&1 || { cat "$tmp/run.log" >&2; fail "mpirun -np $np failed"; }

@@ -1,22 +1,26 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""The two-level CI silo with its levels on rank groups (issue 19, item 4; ctest label long).
+"""A CI silo's discharge on MPI ranks against one process, over seeds (issue 19, items 4 and 5; ctest label long).
 
-usage: silo_2lvl_ranks_check.py DOMEL MPIEXEC NP SCENARIO WORKDIR
+usage: silo_seeds_check.py DOMEL MPIEXEC NP SCENARIO WORKDIR MODE
 
-SCENARIO is scenarios/silo/silo_ci_2lvl.json (alpha = 2 everywhere, alpha = 1
+SCENARIO is scenarios/silo/silo_ci.json (one level: pour, outlet deletion
+region, orifice plane) or silo_ci_2lvl.json (alpha = 2 everywhere, alpha = 1
 in the lower part, coupled through the fine region's +z face with both
 controllers and match_outflow). Its VTK and grid files are switched off (they
 do not change the run). For seeds 1, 2 and 3 (run.seed: the pour's draws) it
-runs on one process and on NP ranks with every subdomain on a rank group of
-its own (rank_share 1 each: the coarse level on the first ranks, the fine on
-the rest), and checks:
+runs on one process and on NP ranks, MODE "spread" (every subdomain over all
+ranks) or "groups" (every subdomain on a rank group of its own, rank_share 1
+each: the coarse level on the first ranks, the fine on the rest), and checks:
 
-- every run ran; on the ranks summary.json names disjoint rank groups that
+- every run ran; with groups, summary.json names disjoint rank groups that
   cover the NP ranks;
-- on the ranks, each level's mass balance is exact (integer units), the fine
-  level's insertions are exactly the coupling's, its removals exactly the
-  region's faces (no deletion region reaches the fine region);
+- on the ranks, each level's mass balance is exact (integer units); the pour
+  inserts what one process inserts (the same particles and kg: its
+  candidates come from every rank alike); without a coupling, the outlet
+  removed what the books say left and the plane counted it; with a coupling, the fine level's
+  insertions are exactly the coupling's, its removals exactly the region's
+  faces (no deletion region reaches the fine region);
 - the discharge (the mass-flow plane under the fine level's orifice, its
   steady rate over 0.65-1.15 s): the mean of the 3 seeds on the ranks lies
   within the one-process seeds' spread of their mean (|mean_ranks -
@@ -33,7 +37,8 @@ import statistics
 import subprocess
 import sys
 
-domel, mpiexec, np, scenario, work = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
+domel, mpiexec, np, scenario, work, mode = (sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5],
+                                           sys.argv[6])
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
 mpi = [mpiexec, "-np", str(np), "--oversubscribe"]
 failures = []
@@ -59,56 +64,65 @@ with open(scenario) as f:
     base = json.load(f)
 base["output"]["vtk_interval"] = 0
 base["output"].pop("grids", None)
-for c in base["couplings"]:
+for c in base.get("couplings", []):
     c["grid_interval"] = 0
+coupled = bool(base.get("couplings"))
 
 rates = {"one": [], "ranks": []}
 for seed in (1, 2, 3):
-    for mode in ("one", "ranks"):
+    pours = {}
+    for where in ("one", "ranks"):
         doc = json.loads(json.dumps(base))
         doc["run"]["seed"] = seed
-        if mode == "ranks":
+        if where == "ranks" and mode == "groups":
             for sd in doc["subdomains"]:
                 sd["rank_share"] = 1
-        path = os.path.join(work, f"silo_{mode}_{seed}.json")
+        path = os.path.join(work, f"silo_{where}_{seed}.json")
         with open(path, "w") as f:
             json.dump(doc, f)
-        out = os.path.join(work, f"{mode}_{seed}")
-        r = run(([] if mode == "one" else mpi) + [domel, "run", path, "--out", out, "--quiet"])
-        check(r is not None and r.returncode == 0, f"seed {seed} {mode} ran: {r.stderr[-800:] if r else ''}")
+        out = os.path.join(work, f"{where}_{seed}")
+        r = run(([] if where == "one" else mpi) + [domel, "run", path, "--out", out, "--quiet"])
+        check(r is not None and r.returncode == 0, f"seed {seed} {where} ran: {r.stderr[-800:] if r else ''}")
         if r is None or r.returncode != 0:
             continue
         s = json.load(open(os.path.join(out, "summary.json")))
         rate = s["mass_flow"]["orifice"]["steady"]["rate_kg_s"]
-        rates[mode].append(rate)
-        if mode == "ranks":
-            groups = sorted((g["rank_group"]["first"], g["rank_group"]["count"]) for g in s["subdomains"])
-            covered = [k for first, count in groups for k in range(first, first + count)]
-            check(covered == list(range(np)), f"seed {seed}: disjoint rank groups covering the {np} ranks: {groups}")
-            for level in ("alpha2", "alpha1"):
-                bal = s["mass_balance"][level]
+        rates[where].append(rate)
+        pours[where] = [(p["inserted"], p["inserted_kg"]) for p in s["pours"]]
+        if where == "ranks":
+            check(pours.get("one") == pours["ranks"], f"seed {seed}: the pours insert what one process inserts: {pours}")
+            if mode == "groups":
+                groups = sorted((g["rank_group"]["first"], g["rank_group"]["count"]) for g in s["subdomains"])
+                covered = [k for first, count in groups for k in range(first, first + count)]
+                check(covered == list(range(np)), f"seed {seed}: disjoint rank groups covering the {np} ranks: {groups}")
+            for level, bal in s["mass_balance"].items():
                 check(bal["exact"] and bal["residual_units_1e-18kg"] == 0, f"seed {seed}: {level}'s books exact: {bal}")
+        if where == "ranks" and not coupled:
+            out, bal = s["deletion_regions"]["outlet"], s["mass_balance"]["grains"]
+            check(out["removed"] > 100 and out["removed"] == bal["removed"], f"seed {seed}: the outlet's books: {out}")
+            check(s["mass_flow"]["orifice"]["net_count"] >= out["removed"], f"seed {seed}: the plane counted what left")
+        if where == "ranks" and coupled:
             c = s["couplings"]["zone1"]
             fine = s["mass_balance"]["alpha1"]
             at_faces = sum(face["removed"] for face in c["faces"].values())
             check(fine["inserted"] == c["faces"]["+z"]["inserted"] > 0,
                   f"seed {seed}: the fine level's insertions are the coupling's: {fine['inserted']} {c['faces']['+z']}")
             check(fine["removed"] == at_faces > 0, f"seed {seed}: the fine removals are the faces': {fine['removed']} {at_faces}")
-        print(f"seed {seed} {mode}: discharge {rate:.5f} kg/s, {s['wall_time_s']:.1f} s wall")
+        print(f"seed {seed} {where}: discharge {rate:.5f} kg/s, {s['wall_time_s']:.1f} s wall", flush=True)
 
 if len(rates["one"]) == 3 and len(rates["ranks"]) == 3:
     m1, mn = statistics.mean(rates["one"]), statistics.mean(rates["ranks"])
     spread = max(rates["one"]) - min(rates["one"])
     print(f"discharge, mean of 3 seeds: one process {m1:.5f} kg/s (spread {spread:.5f}: "
-          f"{', '.join(f'{x:.5f}' for x in rates['one'])}), {np} ranks on rank groups {mn:.5f} kg/s "
-          f"({', '.join(f'{x:.5f}' for x in rates['ranks'])}): {100 * (mn / m1 - 1):+.2f} %")
+          f"{', '.join(f'{x:.5f}' for x in rates['one'])}), {np} ranks ({mode}) {mn:.5f} kg/s "
+          f"({', '.join(f'{x:.5f}' for x in rates['ranks'])}): {100 * (mn / m1 - 1):+.2f} %", flush=True)
     check(abs(mn - m1) <= spread, f"the ranks' mean discharge within the one-process seed spread of its mean")
 
 again = os.path.join(work, "ranks_1_again")
 r = run(mpi + [domel, "run", os.path.join(work, "silo_ranks_1.json"), "--out", again, "--quiet"])
 check(r is not None and r.returncode == 0, "seed 1 on the ranks, again")
 if r is not None and r.returncode == 0:
-    for name in ("probes.csv", "zone1_balance.csv"):
+    for name in ("probes.csv",) + (("zone1_balance.csv",) if coupled else ()):
         with open(os.path.join(work, "ranks_1", name), "rb") as f1, open(os.path.join(again, name), "rb") as f2:
             check(f1.read() == f2.read(), f"{name} is the same run to run on {np} ranks")
 
