@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -135,6 +136,12 @@ void CellGrid::set_accessible(const std::vector<WallPrimitive>& walls, double ti
 
 void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vector<ContactRecord>*>& records,
                       double time) {
+  sample(s, s.size(), records, time, {});
+}
+
+void CellGrid::sample(const ParticleStore& s, std::size_t owned,
+                      const std::vector<const std::vector<ContactRecord>*>& records, double time,
+                      const RankReduction& over_ranks) {
   const std::size_t n = s.size();
   const bool consistent = s.x.size() == n && s.y.size() == n && s.z.size() == n && s.vx.size() == n &&
                           s.vy.size() == n && s.vz.size() == n && s.radius.size() == n &&
@@ -149,7 +156,8 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
   f.time = time;
   f.samples = 1;
 
-  // Pass 1: counts, masses, solid volume, momentum of the mobile particles.
+  // Pass 1: counts, masses, solid volume, momentum of the mobile particles
+  // (own particles only; the ghosts' cells place the contact records).
   cell_scratch_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     double q[3] = {s.x[k], s.y[k], s.z[k]};
@@ -159,7 +167,7 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
           q[a] -= periodic_.length(a) * std::floor((q[a] - periodic_.lo[a]) / periodic_.length(a));
     const std::ptrdiff_t c = cell_of(q[0], q[1], q[2]);
     cell_scratch_[k] = c;
-    if (c < 0) continue;
+    if (c < 0 || k >= owned) continue;
     const double r = s.radius[k];
     f.count[c] += 1;
     f.mass[c] += s.mass[k];
@@ -180,6 +188,31 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
     f.vy[c] += s.mass[k] * s.vy[k];
     f.vz[c] += s.mass[k] * s.vz[k];
   }
+  if (over_ranks) {
+    // every rank's sums, and its extreme velocities (a cell without mobile
+    // particles here: none, -inf), then the sample goes on alike everywhere
+    std::vector<double> sums, maxima;
+    sums.reserve(8 * n_cells_);
+    maxima.reserve(6 * n_cells_);
+    for (const auto* v : {&f.count, &f.count_fixed, &f.mass, &f.volume_fraction, &f.mobile_mass, &f.vx, &f.vy, &f.vz})
+      sums.insert(sums.end(), v->begin(), v->end());
+    constexpr double none = -std::numeric_limits<double>::infinity();
+    for (const auto* v : {&f.vmax_x, &f.vmax_y, &f.vmax_z})
+      for (std::size_t c = 0; c < n_cells_; ++c) maxima.push_back(f.mobile_mass[c] > 0 ? (*v)[c] : none);
+    for (const auto* v : {&f.vmin_x, &f.vmin_y, &f.vmin_z})
+      for (std::size_t c = 0; c < n_cells_; ++c) maxima.push_back(f.mobile_mass[c] > 0 ? -(*v)[c] : none);
+    over_ranks(sums, maxima);
+    if (sums.size() != 8 * n_cells_ || maxima.size() != 6 * n_cells_)
+      throw RuntimeError("cell grid '" + spec_.name + "': the ranks' sums came back with another length");
+    std::size_t at = 0;
+    for (auto* v : {&f.count, &f.count_fixed, &f.mass, &f.volume_fraction, &f.mobile_mass, &f.vx, &f.vy, &f.vz})
+      for (std::size_t c = 0; c < n_cells_; ++c) (*v)[c] = sums[at++];
+    at = 0;
+    for (auto* v : {&f.vmax_x, &f.vmax_y, &f.vmax_z})
+      for (std::size_t c = 0; c < n_cells_; ++c, ++at) (*v)[c] = f.mobile_mass[c] > 0 ? maxima[at] : 0.0;
+    for (auto* v : {&f.vmin_x, &f.vmin_y, &f.vmin_z})
+      for (std::size_t c = 0; c < n_cells_; ++c, ++at) (*v)[c] = f.mobile_mass[c] > 0 ? -maxima[at] : 0.0;
+  }
   // Favre (mass-weighted) cell velocity, physics.md §5.2: u = sum m v / sum m.
   for (std::size_t c = 0; c < n_cells_; ++c) {
     if (f.mobile_mass[c] > 0) {
@@ -192,7 +225,7 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
 
   // Pass 2: kinetic (streaming) stress about the cell velocity,
   // sum m v' (x) v' (physics.md §8), mobile particles only.
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < owned; ++k) {
     const std::ptrdiff_t c = cell_scratch_[k];
     if (c < 0 || s.fixed(k)) continue;
     const double v[3] = {s.vx[k] - f.vx[c], s.vy[k] - f.vy[c], s.vz[k] - f.vz[c]};
@@ -226,6 +259,16 @@ void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vecto
       if (ci >= 0) add_outer(&f.stress[9 * ci], l, r.fx, r.fy, r.fz, 0.5);
       if (cj >= 0) add_outer(&f.stress[9 * cj], l, r.fx, r.fy, r.fz, 0.5);
     }
+  }
+
+  if (over_ranks) {
+    std::vector<double> sums(f.stress_kinetic), none;
+    sums.insert(sums.end(), f.stress.begin(), f.stress.end());
+    over_ranks(sums, none);
+    if (sums.size() != 18 * n_cells_)
+      throw RuntimeError("cell grid '" + spec_.name + "': the ranks' sums came back with another length");
+    std::copy(sums.begin(), sums.begin() + static_cast<std::ptrdiff_t>(9 * n_cells_), f.stress_kinetic.begin());
+    std::copy(sums.begin() + static_cast<std::ptrdiff_t>(9 * n_cells_), sums.end(), f.stress.begin());
   }
 
   // Divide by the accessible volume V_c w_c (physics.md §8). A cell the

@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -169,6 +170,21 @@ class CellGrid {
   /// out of range of the store. Replaces latest() and adds to the running mean.
   void sample(const ParticleStore& s, const std::vector<const std::vector<ContactRecord>*>& records,
               double time);
+  /// Over MPI ranks: adds one rank's partial per-cell values up over all
+  /// ranks, element-wise `sums` and `maxima`, the same bits on every rank.
+  /// Collective.
+  using RankReduction = std::function<void(std::vector<double>& sums, std::vector<double>& maxima)>;
+  /// The same sample of a subdomain spread over ranks, from each rank's own
+  /// part: the particles s[0, owned) (the rest are ghosts, whose positions
+  /// only place the contact records) and the contacts this rank computed
+  /// (each pair and wall contact is computed on one rank). The per-cell sums
+  /// are reduced in two passes (counts, masses and momenta; then the kinetic
+  /// stress about the reduced Favre velocities and the contact virial), so
+  /// every rank holds the whole sample without gathering any particle.
+  /// Collective: every rank calls it, a rank without particles too.
+  void sample(const ParticleStore& s, std::size_t owned,
+              const std::vector<const std::vector<ContactRecord>*>& records, double time,
+              const RankReduction& over_ranks);
 
   /// The last sample (for controllers and couplers); all zero before the first.
   const CellFields& latest() const { return latest_; }

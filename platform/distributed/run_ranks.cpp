@@ -13,11 +13,13 @@ namespace domel::platform {
 void MpiRunRanks::distribute(Subdomain& sd, int first, int count) {
   // every rank built the same particles: each rank of the group keeps every
   // count-th by id (the first exchange moves each to the owner of its
-  // place); the ranks outside keep none
+  // place); the ranks outside keep none. A group of one rank holds the
+  // subdomain as one process does (no exchange: the fused step).
   const bool whole = count <= 0 || (first == 0 && count == comm_.size());
   const bool member = whole || (comm_.rank() >= first && comm_.rank() < first + count);
   const Communicator group = whole ? comm_ : comm_.split(member ? 0 : 1);
   group_size_.emplace_back(&sd, whole ? comm_.size() : count);
+  if (member && group.size() == 1) return;
   ParticleStore& s = sd.store();
   std::vector<std::uint8_t> other(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) other[k] = !member || !starts_on_rank(s.id[k], group.rank(), group.size());

@@ -98,6 +98,26 @@ class RunRanks {
     }
     return total;
   }
+  /// Element-wise sums (added up in rank order) and maxima over the ranks,
+  /// in place: the same bits on every rank. Collective.
+  void reduce_in_rank_order(std::vector<double>& sums, std::vector<double>& maxima) {
+    std::vector<double> both(sums);
+    both.insert(both.end(), maxima.begin(), maxima.end());
+    std::vector<char> bytes(both.size() * sizeof(double));
+    if (!both.empty()) std::memcpy(bytes.data(), both.data(), bytes.size());
+    std::fill(sums.begin(), sums.end(), 0.0);
+    bool first = true;
+    for (const auto& b : all_gather(bytes)) {
+      if (b.size() != bytes.size()) throw RuntimeError("reduction over the ranks: the ranks sent different lengths");
+      for (std::size_t k = 0; k < both.size(); ++k) {
+        double x;
+        std::memcpy(&x, b.data() + k * sizeof(double), sizeof(double));
+        if (k < sums.size()) sums[k] += x;
+        else maxima[k - sums.size()] = first ? x : std::max(maxima[k - sums.size()], x);
+      }
+      first = false;
+    }
+  }
   /// The largest x over the ranks. Collective.
   virtual double max(double x) = 0;
   /// What sd's ranks exchanged since the start, summed over the ranks (for

@@ -307,19 +307,22 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
     if (!record) return;
     if (ranks) {
-      // every rank samples its grids from every rank's particles and records
-      bool due = false;
-      for (const auto& s : samplers) due = due || (s.subdomain == k && s.grid->due(sd.steps()));
-      if (due || for_outputs) {
+      // every rank samples its grids from its own particles and records,
+      // the per-cell sums reduced over the ranks (CellGrid::sample); the
+      // outputs' contact sample reads every rank's, gathered
+      const CellGrid::RankReduction reduce = [&](std::vector<double>& sums, std::vector<double>& maxima) {
+        ranks->reduce_in_rank_order(sums, maxima);
+      };
+      for (const auto& s : samplers) {
+        if (s.subdomain != k || !s.grid->due(sd.steps())) continue;
+        const auto t0 = std::chrono::steady_clock::now();
+        s.grid->sample(sd.store(), sd.owned(), sd.contact_records(), sd.time(), reduce);
+        if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      }
+      if (for_outputs) {
         const ParticleStore all = ranks->gather(sd, true);
         const std::vector<ContactRecord> records = gather_contact_records(*ranks, sd, all);
-        for (const auto& s : samplers) {
-          if (s.subdomain != k || !s.grid->due(sd.steps())) continue;
-          const auto t0 = std::chrono::steady_clock::now();
-          s.grid->sample(all, {&records}, sd.time());
-          if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        }
-        if (for_outputs) contact_sample.take(k, sd, all, {&records}, walls);
+        contact_sample.take(k, sd, all, {&records}, walls);
       }
       sd.set_record_contacts(false);
       return;

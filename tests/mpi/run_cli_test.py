@@ -62,20 +62,23 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR
    6 g in all) for 6000 steps (the first fills land by 0.03 s): the
    same particles and kg as one process, the same count in every probe row,
    the kinetic energy within 1e-6.
-12. Coupled levels (silo_ci_2lvl, its files off) for 1950 steps (0.07 s: the
-   coarse pour falls into the fine region, which fills by transfers; from
-   then on the fine particles' fast collisions in the filling region grow
-   round-off by 1e6 within 0.01 s, on one process with 2 threads as on
-   ranks: 1.3e-10 at 0.07 s, 5e-5 at 0.08), on NP ranks twice: every level
+12. Coupled levels (silo_ci_2lvl, its files off) for 1500 steps (0.054 s: the
+   coarse pour falls into the fine region, whose first transfers and
+   controller actions come at 0.04-0.05 s), on NP ranks twice: every level
    spread over all ranks, and every level on a rank group of its own
    (rank_share): each level's books exact, the same particles in every
    probe row, the same parcels counted and fine particles inserted as one
    process, the kinetic energies within 1e-6 of one process's largest
-   (measured 4e-10 at most spread, 6e-11 on groups, on 2-4 ranks; 1.3e-10
-   for one process on 2 threads). On rank groups, checkpointed at 1000 steps: the restart on
-   NP ranks writes the uninterrupted run's probes.csv and balance file byte
-   for byte; the restart on another rank count is a continuation within
-   1e-6.
+   (measured 2e-13 at most on 2-4 ranks; one process on 2 threads 8e-17).
+   Later the run turns chaotic: the stress controller resets its integral
+   where the set point is not positive (physics.md §5.3), and a cell holding
+   one free coarse parcel has a kinetic stress of 0 or 1e-35 by round-off, so
+   on 3 and 4 ranks (cell sums in another order) a push differs from 0.0575 s
+   on (1e-3 by 0.06 s); the fine region's fast collisions do the same from
+   0.072 s on 2 ranks and on one process with 2 threads. On rank groups,
+   checkpointed at 800 steps: the restart on NP ranks writes the
+   uninterrupted run's probes.csv and balance file byte for byte; the
+   restart on another rank count is a continuation within 1e-6.
 """
 import csv
 import json
@@ -476,7 +479,7 @@ doc["output"].pop("grids", None)
 doc["couplings"][0]["grid_interval"] = 0
 levels = write_scenario(doc, "levels")
 o1 = os.path.join(work, "levels_one")
-r1 = run([domel, "run", levels, "--out", o1, "--quiet", "--max-steps", "1950"])
+r1 = run([domel, "run", levels, "--out", o1, "--quiet", "--max-steps", "1500"])
 check(r1 is not None and r1.returncode == 0, f"the coupled levels on one process ran: {r1.stderr[-600:] if r1 else ''}")
 for sd in doc["subdomains"]:
     sd["rank_share"] = 1
@@ -485,7 +488,7 @@ grouped = write_scenario(doc, "levels_groups")
 folders = {}
 for mode, path in (("spread", levels), ("groups", grouped)):
     folders[mode] = os.path.join(work, "levels_" + mode)
-    r = run(mpi + [domel, "run", path, "--out", folders[mode], "--quiet", "--max-steps", "1950"])
+    r = run(mpi + [domel, "run", path, "--out", folders[mode], "--quiet", "--max-steps", "1500"])
     check(r is not None and r.returncode == 0, f"the coupled levels on {np} ranks ({mode}) ran: {r.stderr[-600:] if r else ''}")
 if r1 is not None and r1.returncode == 0 and all(os.path.exists(os.path.join(f, "summary.json")) for f in folders.values()):
     a = json.load(open(os.path.join(o1, "summary.json")))
@@ -498,14 +501,14 @@ if r1 is not None and r1.returncode == 0 and all(os.path.exists(os.path.join(f, 
             bal = b["mass_balance"][level]
             check(bal["exact"] and bal["residual_units_1e-18kg"] == 0, f"{mode}: {level}'s books exact: {bal}")
         fa, fb = a["couplings"]["zone1"]["faces"]["+z"], b["couplings"]["zone1"]["faces"]["+z"]
-        check(fa["counted_parcels"] == fb["counted_parcels"] > 0 and fa["inserted"] == fb["inserted"] > 1000,
+        check(fa["counted_parcels"] == fb["counted_parcels"] > 0 and fa["inserted"] == fb["inserted"] > 500,
               f"{mode}: the parcels counted and the fine particles inserted as on one process: {fa} against {fb}")
         if mode == "groups":
             groups = sorted((g["rank_group"]["first"], g["rank_group"]["count"]) for g in b["subdomains"])
             check(groups[0][0] == 0 and groups[0][0] + groups[0][1] == groups[1][0] and sum(g[1] for g in groups) == np,
                   f"disjoint rank groups covering the {np} ranks: {groups}")
         hn, pn = probes(folder)
-        check(h1 == hn and len(p1) == len(pn) and len(p1) >= 8, f"{mode}: the same probe rows")
+        check(h1 == hn and len(p1) == len(pn) and len(p1) >= 6, f"{mode}: the same probe rows")
         worst = 0.0
         for c in ke:
             scale = max(abs(row[c]) for row in p1) or 1.0
@@ -516,11 +519,11 @@ if r1 is not None and r1.returncode == 0 and all(os.path.exists(os.path.join(f, 
         check(worst < 1e-6, f"{mode}: the kinetic energies within 1e-6 (found {worst:.3g})")
     # restarts on rank groups
     part, moved = os.path.join(work, "levels_part"), os.path.join(work, "levels_moved")
-    r = run(mpi + [domel, "run", grouped, "--out", part, "--quiet", "--max-steps", "1000"])
+    r = run(mpi + [domel, "run", grouped, "--out", part, "--quiet", "--max-steps", "800"])
     check(r is not None and r.returncode == 0, "the checkpointed coupled levels ran")
     if r is not None and r.returncode == 0:
         shutil.copytree(part, moved)
-        restart = ["--quiet", "--max-steps", "1950", "--restart"]
+        restart = ["--quiet", "--max-steps", "1500", "--restart"]
         r = run(mpi + [domel, "run", grouped, "--out", part] + restart + [os.path.join(part, "checkpoint.ckpt")])
         check(r is not None and r.returncode == 0, f"the restart on {np} ranks ran: {r.stderr[-600:] if r else ''}")
         if r is not None and r.returncode == 0:
