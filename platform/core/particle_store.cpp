@@ -149,11 +149,19 @@ void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
   if (!same) r.fail(p + "id", "has per-particle arrays of different lengths");
 }
 
-void ParticleStore::append(const ParticleStore& other) {
-  if (other.external_force_ != external_force_ || other.aux.size() != aux.size())
+namespace {
+/// Each array of `from`, in for_each_array's order, for appending to `to`.
+std::vector<const void*> arrays_to_append(const ParticleStore& to, const ParticleStore& from) {
+  if (from.has_external_force() != to.has_external_force() || from.aux.size() != to.aux.size())
     throw std::invalid_argument("ParticleStore::append: the stores differ in external forces or aux arrays");
-  std::vector<const void*> from;
-  other.for_each_array([&](const auto& v) { from.push_back(&v); });
+  std::vector<const void*> arrays;
+  from.for_each_array([&](const auto& v) { arrays.push_back(&v); });
+  return arrays;
+}
+}  // namespace
+
+void ParticleStore::append(const ParticleStore& other) {
+  const std::vector<const void*> from = arrays_to_append(*this, other);
   std::size_t k = 0;
   for_each_array([&](auto& v) {
     const auto& src = *static_cast<const std::remove_reference_t<decltype(v)>*>(from[k++]);
@@ -162,10 +170,7 @@ void ParticleStore::append(const ParticleStore& other) {
 }
 
 void ParticleStore::append(const ParticleStore& other, const std::vector<std::uint32_t>& which) {
-  if (other.external_force_ != external_force_ || other.aux.size() != aux.size())
-    throw std::invalid_argument("ParticleStore::append: the stores differ in external forces or aux arrays");
-  std::vector<const void*> from;
-  other.for_each_array([&](const auto& v) { from.push_back(&v); });
+  const std::vector<const void*> from = arrays_to_append(*this, other);
   std::size_t k = 0;
   for_each_array([&](auto& v) {
     const auto& src = *static_cast<const std::remove_reference_t<decltype(v)>*>(from[k++]);

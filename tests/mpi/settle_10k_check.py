@@ -20,8 +20,10 @@ import shutil
 import subprocess
 import sys
 
+import mpi_cli
+
 domel, mpiexec, np, scenario, work = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
-env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
+env = mpi_cli.env
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 with open(scenario) as f:

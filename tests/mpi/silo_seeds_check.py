@@ -34,28 +34,18 @@ import json
 import os
 import shutil
 import statistics
-import subprocess
 import sys
+
+import mpi_cli
 
 domel, mpiexec, np, scenario, work, mode = (sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5],
                                            sys.argv[6])
-env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
-mpi = [mpiexec, "-np", str(np), "--oversubscribe"]
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAIL:", what)
+mpi = mpi_cli.mpi(mpiexec, np)
+check, failures = mpi_cli.check, mpi_cli.failures
 
 
 def run(cmd, timeout=900):
-    try:
-        return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        check(False, "timed out (a hang): " + " ".join(cmd))
-        return None
+    return mpi_cli.run(cmd, timeout)
 
 
 shutil.rmtree(work, ignore_errors=True)

@@ -1,0 +1,29 @@
+# SPDX-License-Identifier: MIT
+"""What the tests that run `domel run` under mpirun share: the environment
+(OpenMPI refuses to start as root unless told; CI runs as root), the checks
+that collect failures, and a run with a time limit (a hang fails, it does
+not block)."""
+import os
+import subprocess
+
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
+failures = []
+
+
+def mpi(mpiexec, np):
+    """The launcher's words for np ranks on a machine with fewer cores."""
+    return [mpiexec, "-np", str(np), "--oversubscribe"]
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print("FAIL:", what, flush=True)
+
+
+def run(cmd, timeout=240):
+    try:
+        return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        check(False, "timed out (a hang): " + " ".join(cmd))
+        return None
