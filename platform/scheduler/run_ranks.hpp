@@ -85,17 +85,8 @@ class RunRanks {
   /// Element-wise sums over the ranks, added up in rank order, so the same
   /// bits on every rank and run to run for a given rank count. Collective.
   std::vector<double> sum_in_rank_order(const std::vector<double>& mine) {
-    std::vector<char> bytes(mine.size() * sizeof(double));
-    if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
-    std::vector<double> total(mine.size(), 0.0);
-    for (const auto& b : all_gather(bytes)) {
-      if (b.size() != bytes.size()) throw RuntimeError("sum over the ranks: the ranks sent different lengths");
-      for (std::size_t k = 0; k < total.size(); ++k) {
-        double x;
-        std::memcpy(&x, b.data() + k * sizeof(double), sizeof(double));
-        total[k] += x;
-      }
-    }
+    std::vector<double> total(mine), none;
+    reduce_in_rank_order(total, none);
     return total;
   }
   /// Element-wise sums (added up in rank order) and maxima over the ranks,

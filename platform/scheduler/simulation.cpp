@@ -218,16 +218,17 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   // Wall loads and contact rows from subdomain k's recorded contacts; spread
   // over ranks, from every rank's particles and records, gathered on every
   // rank (the same sums everywhere: a servo moves its wall alike on all).
+  auto take_contact_sample = [&](std::size_t k) {
+    Subdomain& sd = *subdomains[k];
+    if (!ranks) return contact_sample.take(k, sd, walls);
+    const ParticleStore all = ranks->gather(sd, true);
+    const std::vector<ContactRecord> records = gather_contact_records(*ranks, sd, all);
+    contact_sample.take(k, sd, all, {&records}, walls);
+  };
   if (!ck && contact_sample.enabled()) {
     contact_sample.begin(0.0);
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
-      if (!ranks) {
-        contact_sample.take(k, *subdomains[k], walls);
-      } else {
-        const ParticleStore all = ranks->gather(*subdomains[k], true);
-        const std::vector<ContactRecord> records = gather_contact_records(*ranks, *subdomains[k], all);
-        contact_sample.take(k, *subdomains[k], all, {&records}, walls);
-      }
+      take_contact_sample(k);
       subdomains[k]->set_record_contacts(false);
     }
   }
@@ -319,11 +320,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
         s.grid->sample(sd.store(), sd.owned(), sd.contact_records(), sd.time(), reduce);
         if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       }
-      if (for_outputs) {
-        const ParticleStore all = ranks->gather(sd, true);
-        const std::vector<ContactRecord> records = gather_contact_records(*ranks, sd, all);
-        contact_sample.take(k, sd, all, {&records}, walls);
-      }
+      if (for_outputs) take_contact_sample(k);
       sd.set_record_contacts(false);
       return;
     }

@@ -20,7 +20,8 @@ usage: run_cli_test.py DOMEL MPIEXEC NP SCENARIO WORKDIR
 2. A scenario whose levels' rank groups are half given (silo_ci_2lvl with a
    rank_share on its first subdomain only) is refused with the JSON pointer
    of the other, on every rank, non-zero exit, rank 0 alone reporting it,
-   nothing written.
+   nothing written; on 2 ranks, rank groups for silo_3lvl's three levels
+   are refused with /subdomains/0/rank_share, nothing written.
 3. A failure on rank 0 alone (its output folder holds an earlier run) ends
    every rank with a non-zero exit and that rank's message, never a hang;
    so does a run that blows up (a time step 4 times the stability limit,
@@ -195,6 +196,19 @@ if r is not None:
     check("/subdomains/1" in r.stderr and "rank_share" in r.stderr, "the refusal names the pointer: " + r.stderr)
     check(r.stderr.count("nothing was run") == 1, "rank 0 alone reports it")
     check(not os.path.exists(os.path.join(refused_out, "summary.json")), "nothing written")
+# 2b. rank groups for more subdomains than ranks (silo_3lvl's three levels, on 2 ranks): refused, nothing written
+if np < 3:
+    with open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(scenario))), "silo", "silo_3lvl.json")) as f:
+        doc = json.load(f)
+    for sd in doc["subdomains"]:
+        sd["rank_share"] = 1
+    few_out = os.path.join(work, "few_ranks")
+    r = run(mpi + [domel, "run", write_scenario(doc, "three_groups"), "--out", few_out, "--quiet"])
+    if r is not None:
+        check(r.returncode != 0, "more rank groups than ranks are refused")
+        check("/subdomains/0/rank_share" in r.stderr and "at least 3 ranks" in r.stderr,
+              "the refusal names the pointer and the ranks needed: " + r.stderr[-600:])
+        check(not os.path.exists(os.path.join(few_out, "summary.json")), "nothing written for the refused groups")
 
 # 3. rank 0 alone fails (its folder holds the earlier run): every rank ends
 r = run(mpi + [domel] + args + ["--out", many], timeout=120)
