@@ -2,16 +2,18 @@
 # SPDX-License-Identifier: MIT
 """A CI silo's discharge on MPI ranks against one process, over seeds (issue 19, items 4 and 5; ctest label long).
 
-usage: silo_seeds_check.py DOMEL MPIEXEC NP SCENARIO WORKDIR MODE
+usage: silo_seeds_check.py DOMEL MPIEXEC NPS SCENARIO WORKDIR MODE
 
 SCENARIO is scenarios/silo/silo_ci.json (one level: pour, outlet deletion
 region, orifice plane) or silo_ci_2lvl.json (alpha = 2 everywhere, alpha = 1
 in the lower part, coupled through the fine region's +z face with both
 controllers and match_outflow). Its VTK and grid files are switched off (they
-do not change the run). For seeds 1, 2 and 3 (run.seed: the pour's draws) it
-runs on one process and on NP ranks, MODE "spread" (every subdomain over all
-ranks) or "groups" (every subdomain on a rank group of its own, rank_share 1
-each: the coarse level on the first ranks, the fine on the rest), and checks:
+do not change the run). NPS is a rank count or a comma-separated list of
+them ("2,3,4"). For seeds 1, 2 and 3 (run.seed: the pour's draws) it runs on
+one process, and on each of the rank counts, MODE "spread" (every subdomain
+over all ranks) or "groups" (every subdomain on a rank group of its own,
+rank_share 1 each: the coarse level on the first ranks, the fine on the
+rest), and checks, for each rank count:
 
 - every run ran; with groups, summary.json names disjoint rank groups that
   cover the NP ranks;
@@ -27,8 +29,9 @@ each: the coarse level on the first ranks, the fine on the rest), and checks:
   mean_one| <= max_one - min_one). A silo's rate is chaotic: round-off alone
   (another rank count, another thread count) moves it by a few %, as another
   seed does, so the seed spread is the yardstick, not a tolerance of ours;
-- seed 1 once more on the ranks: probes.csv and the coupling's balance file
-  are the same bytes (reproducible for a given rank count).
+- seed 1 once more on the last rank count: probes.csv and the coupling's
+  balance file are the same bytes (reproducible for a given rank count;
+  tests/mpi/run_cli_test.py checks it on 2, 3 and 4 ranks for another case).
 """
 import json
 import os
@@ -38,9 +41,8 @@ import sys
 
 import mpi_cli
 
-domel, mpiexec, np, scenario, work, mode = (sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5],
-                                           sys.argv[6])
-mpi = mpi_cli.mpi(mpiexec, np)
+domel, mpiexec, nps, scenario, work, mode = (sys.argv[1], sys.argv[2], [int(n) for n in sys.argv[3].split(",")],
+                                            sys.argv[4], sys.argv[5], sys.argv[6])
 check, failures = mpi_cli.check, mpi_cli.failures
 
 
@@ -57,21 +59,23 @@ base["output"].pop("grids", None)
 for c in base.get("couplings", []):
     c["grid_interval"] = 0
 coupled = bool(base.get("couplings"))
+wheres = ["one"] + [f"np{n}" for n in nps]
 
-rates = {"one": [], "ranks": []}
+rates = {where: [] for where in wheres}
 for seed in (1, 2, 3):
     pours = {}
-    for where in ("one", "ranks"):
+    for where in wheres:
+        np = 1 if where == "one" else int(where[2:])
         doc = json.loads(json.dumps(base))
         doc["run"]["seed"] = seed
-        if where == "ranks" and mode == "groups":
+        if np > 1 and mode == "groups":
             for sd in doc["subdomains"]:
                 sd["rank_share"] = 1
         path = os.path.join(work, f"silo_{where}_{seed}.json")
         with open(path, "w") as f:
             json.dump(doc, f)
         out = os.path.join(work, f"{where}_{seed}")
-        r = run(([] if where == "one" else mpi) + [domel, "run", path, "--out", out, "--quiet"])
+        r = run(([] if np == 1 else mpi_cli.mpi(mpiexec, np)) + [domel, "run", path, "--out", out, "--quiet"])
         check(r is not None and r.returncode == 0, f"seed {seed} {where} ran: {r.stderr[-800:] if r else ''}")
         if r is None or r.returncode != 0:
             continue
@@ -79,42 +83,56 @@ for seed in (1, 2, 3):
         rate = s["mass_flow"]["orifice"]["steady"]["rate_kg_s"]
         rates[where].append(rate)
         pours[where] = [(p["inserted"], p["inserted_kg"]) for p in s["pours"]]
-        if where == "ranks":
-            check(pours.get("one") == pours["ranks"], f"seed {seed}: the pours insert what one process inserts: {pours}")
+        if np > 1:
+            check(pours.get("one") == pours[where],
+                  f"seed {seed} {where}: the pours insert what one process inserts: {pours}")
             if mode == "groups":
                 groups = sorted((g["rank_group"]["first"], g["rank_group"]["count"]) for g in s["subdomains"])
                 covered = [k for first, count in groups for k in range(first, first + count)]
                 check(covered == list(range(np)), f"seed {seed}: disjoint rank groups covering the {np} ranks: {groups}")
             for level, bal in s["mass_balance"].items():
-                check(bal["exact"] and bal["residual_units_1e-18kg"] == 0, f"seed {seed}: {level}'s books exact: {bal}")
-        if where == "ranks" and not coupled:
+                check(bal["exact"] and bal["residual_units_1e-18kg"] == 0,
+                      f"seed {seed} {where}: {level}'s books exact: {bal}")
+        if np > 1 and not coupled:
             out, bal = s["deletion_regions"]["outlet"], s["mass_balance"]["grains"]
-            check(out["removed"] > 100 and out["removed"] == bal["removed"], f"seed {seed}: the outlet's books: {out}")
-            check(s["mass_flow"]["orifice"]["net_count"] >= out["removed"], f"seed {seed}: the plane counted what left")
-        if where == "ranks" and coupled:
+            check(out["removed"] > 100 and out["removed"] == bal["removed"],
+                  f"seed {seed} {where}: the outlet's books: {out}")
+            check(s["mass_flow"]["orifice"]["net_count"] >= out["removed"],
+                  f"seed {seed} {where}: the plane counted what left")
+        if np > 1 and coupled:
             c = s["couplings"]["zone1"]
             fine = s["mass_balance"]["alpha1"]
             at_faces = sum(face["removed"] for face in c["faces"].values())
             check(fine["inserted"] == c["faces"]["+z"]["inserted"] > 0,
-                  f"seed {seed}: the fine level's insertions are the coupling's: {fine['inserted']} {c['faces']['+z']}")
-            check(fine["removed"] == at_faces > 0, f"seed {seed}: the fine removals are the faces': {fine['removed']} {at_faces}")
+                  f"seed {seed} {where}: the fine level's insertions are the coupling's: {fine['inserted']} "
+                  f"{c['faces']['+z']}")
+            check(fine["removed"] == at_faces > 0,
+                  f"seed {seed} {where}: the fine removals are the faces': {fine['removed']} {at_faces}")
         print(f"seed {seed} {where}: discharge {rate:.5f} kg/s, {s['wall_time_s']:.1f} s wall", flush=True)
 
-if len(rates["one"]) == 3 and len(rates["ranks"]) == 3:
-    m1, mn = statistics.mean(rates["one"]), statistics.mean(rates["ranks"])
+if len(rates["one"]) == 3:
+    m1 = statistics.mean(rates["one"])
     spread = max(rates["one"]) - min(rates["one"])
     print(f"discharge, mean of 3 seeds: one process {m1:.5f} kg/s (spread {spread:.5f}: "
-          f"{', '.join(f'{x:.5f}' for x in rates['one'])}), {np} ranks ({mode}) {mn:.5f} kg/s "
-          f"({', '.join(f'{x:.5f}' for x in rates['ranks'])}): {100 * (mn / m1 - 1):+.2f} %", flush=True)
-    check(abs(mn - m1) <= spread, f"the ranks' mean discharge within the one-process seed spread of its mean")
+          f"{', '.join(f'{x:.5f}' for x in rates['one'])})", flush=True)
+    for where in wheres[1:]:
+        if len(rates[where]) != 3:
+            continue
+        mn = statistics.mean(rates[where])
+        print(f"  {where[2:]} ranks ({mode}) {mn:.5f} kg/s ({', '.join(f'{x:.5f}' for x in rates[where])}): "
+              f"{100 * (mn / m1 - 1):+.2f} %", flush=True)
+        check(abs(mn - m1) <= spread,
+              f"{where[2:]} ranks: the mean discharge within the one-process seed spread of its mean")
 
-again = os.path.join(work, "ranks_1_again")
-r = run(mpi + [domel, "run", os.path.join(work, "silo_ranks_1.json"), "--out", again, "--quiet"])
-check(r is not None and r.returncode == 0, "seed 1 on the ranks, again")
+last = wheres[-1]
+again = os.path.join(work, f"{last}_1_again")
+r = run(mpi_cli.mpi(mpiexec, nps[-1]) + [domel, "run", os.path.join(work, f"silo_{last}_1.json"), "--out", again,
+                                        "--quiet"])
+check(r is not None and r.returncode == 0, f"seed 1 on {nps[-1]} ranks, again")
 if r is not None and r.returncode == 0:
     for name in ("probes.csv",) + (("zone1_balance.csv",) if coupled else ()):
-        with open(os.path.join(work, "ranks_1", name), "rb") as f1, open(os.path.join(again, name), "rb") as f2:
-            check(f1.read() == f2.read(), f"{name} is the same run to run on {np} ranks")
+        with open(os.path.join(work, f"{last}_1", name), "rb") as f1, open(os.path.join(again, name), "rb") as f2:
+            check(f1.read() == f2.read(), f"{name} is the same run to run on {nps[-1]} ranks")
 
 print("passed" if not failures else f"{len(failures)} failure(s)")
 sys.exit(1 if failures else 0)
