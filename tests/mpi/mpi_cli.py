@@ -15,6 +15,20 @@ def mpi(mpiexec, np):
     return [mpiexec, "-np", str(np), "--oversubscribe"]
 
 
+def launcher(mpiexec, np):
+    """What goes before `domel run` for np ranks: nothing for one process."""
+    return [] if np == 1 else mpi(mpiexec, np)
+
+
+def mean_within_seed_spread(one, ranks):
+    """The yardstick of the seed-over checks (silo_seeds_check.py,
+    repose_check.py): the ranks' mean lies within the one-process seeds'
+    spread of their mean. Returns (mean_one, mean_ranks, spread, whether)."""
+    m1, mn = sum(one) / len(one), sum(ranks) / len(ranks)
+    spread = max(one) - min(one)
+    return m1, mn, spread, abs(mn - m1) <= spread
+
+
 def check(ok, what):
     if not ok:
         failures.append(what)
