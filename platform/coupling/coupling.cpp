@@ -222,7 +222,7 @@ void Coupling::count_inflow(const ParticleStore& s) {
         if (u > last) last = u, face = 2 * a + 1;
       }
     }
-    if (face < 0 || !spec_.inflow[face] || !counted_ids_.insert(s.id[q]).second) continue;
+    if (face < 0 || !spec_.inflow[face] || !counted_ids_[face].insert(s.id[q]).second) continue;
     FaceBalance& fb = faces_[face];
     const double m = s.mass[q];
     fb.counted += mass_units(m);
@@ -249,7 +249,7 @@ void Coupling::count_inflow(const ParticleStore& s) {
     // cannot leave the followed margin within one interval, see above) or
     // outside through a face that is not an inflow face. A parcel that goes
     // out through an inflow face (a bounce during a fill) is the transfer's
-    // business: it comes back, and is counted once.
+    // business: it comes back, and that face counts it once.
     for (const auto& [id, prev] : coarse_last_) {
       if (!inside_box(g, prev[0], prev[1], prev[2])) continue;
       const auto it = now.find(id);
@@ -620,9 +620,11 @@ void Coupling::save(ArchiveWriter& w, const std::string& p) {
   }
   w.put(p + "followed_ids", ids);
   w.put(p + "followed", last);
-  std::vector<std::uint64_t> counted(counted_ids_.begin(), counted_ids_.end());
-  std::sort(counted.begin(), counted.end());
-  w.put(p + "counted_ids", counted);
+  for (int face = 0; face < kFaces; ++face) {
+    std::vector<std::uint64_t> counted(counted_ids_[face].begin(), counted_ids_[face].end());
+    std::sort(counted.begin(), counted.end());
+    w.put(p + "face" + std::to_string(face) + "_counted_ids", counted);
+  }
   std::ostringstream rng;
   rng << rng_;
   w.put_text(p + "rng", rng.str());
@@ -674,8 +676,10 @@ void Coupling::load(const ArchiveReader& r, const std::string& p) {
   coarse_last_.clear();
   for (std::size_t k = 0; k < ids.size(); ++k)
     coarse_last_[ids[k]] = {last[4 * k], last[4 * k + 1], last[4 * k + 2], last[4 * k + 3]};
-  const auto counted = r.get<std::uint64_t>(p + "counted_ids");
-  counted_ids_ = std::unordered_set<std::uint64_t>(counted.begin(), counted.end());
+  for (int face = 0; face < kFaces; ++face) {
+    const auto counted = r.get<std::uint64_t>(p + "face" + std::to_string(face) + "_counted_ids");
+    counted_ids_[face] = std::unordered_set<std::uint64_t>(counted.begin(), counted.end());
+  }
   std::istringstream rng(r.text(p + "rng"));
   rng >> rng_;
   if (!rng) r.fail(p + "rng", "does not hold the state of a 64-bit Mersenne Twister");

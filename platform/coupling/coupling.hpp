@@ -8,7 +8,9 @@
 //   1. removes the fine particles whose centre has left the region and books
 //      them as outflow of the face they crossed;
 //   2. counts the coarse parcels that entered the region through an inflow
-//      face since the last interval, once per parcel (mass, momentum, size);
+//      face since the last interval, each parcel once per face (mass,
+//      momentum, size): a face is one counting surface, as each of
+//      LIGGGHTS-PFM's massflow/mesh/face fixes counts once on its own;
 //   3. when a transfer is due (the counted material would fill a face's
 //      insertion shell beyond fill_target, or transfer_max_steps passed),
 //      turns what each face counted into fine particles
@@ -217,7 +219,8 @@ class Coupling {
   std::array<FaceBalance, kFaces> faces_;
   /// parcel id -> position and mass at the last count, for the parcels near the region
   std::unordered_map<std::uint64_t, std::array<double, 4>> coarse_last_;
-  std::unordered_set<std::uint64_t> counted_ids_;                         ///< parcels already counted (count once)
+  /// per face, the parcels it has counted (each face counts a parcel once)
+  std::array<std::unordered_set<std::uint64_t>, kFaces> counted_ids_;
   std::mt19937_64 rng_;
   std::uint64_t controls_ = 0, transfers_ = 0;
   std::uint64_t since_transfer_ = 0;  ///< control intervals since the last transfer

@@ -19,7 +19,9 @@ and the coupled ones (docs/multilevel.md, docs/validation/multilevel.md):
   silo_ci_2lvl.json silo_ci at alpha = 2 with a fine level in its lower half
                     (the CI-sized coupled case), and silo_ci_2lvl_nostress.json
                     the same without the stress controller, and
-                    silo_ci_2lvl_nomatch.json without match_outflow.
+                    silo_ci_2lvl_nomatch.json without match_outflow;
+  silo_2lvl_nostress.json  silo_2lvl without the stress controller (what the
+                    transition cells' pressure is without it).
 Every variant has a grid "zone" with the fine region's cells, so that the
 pressure in the transition cells compares level by level.
 Each pours at a mass rate from a cylinder near the top (random sequential
@@ -171,6 +173,8 @@ if __name__ == "__main__":
         variants = [(name, True, True)]
         if name == "silo_ci_2lvl":
             variants += [(name + "_nostress", False, True), (name + "_nomatch", True, False)]
+        elif name == "silo_2lvl":
+            variants += [(name + "_nostress", False, True)]
         for out, stress, match in variants:
             with open(os.path.join(HERE, out + ".json"), "w") as f:
                 json.dump(multilevel(out, base, levels, stress, match), f, indent=2)

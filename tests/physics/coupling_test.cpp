@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Guards the coupling between levels (issue 14; coupling/coupling.hpp,
 // docs/multilevel.md): coarse parcels crossing an inflow face are counted
-// once, with their mass, and become (alpha_c/alpha_f)^3 fine particles each,
+// once by that face, with their mass, and become (alpha_c/alpha_f)^3 fine particles each,
 // placed without overlap in the shell behind the face with the face's
 // mass-weighted velocity; what cannot be placed waits as backlog; fine
 // particles leaving the region are removed and booked to the face they
@@ -148,6 +148,41 @@ TEST(Coupling, CountsEachParcelOnceAndInsertsItsFineParticlesInTheShell) {
   s.exchange(4e-3);
   EXPECT_EQ(top.parcels, 5u);
   EXPECT_EQ(s.sim->flow.residual(1, f), 0);
+}
+
+// Each inflow face is a counting surface of its own, as each of LIGGGHTS-PFM's
+// massflow/mesh/face fixes counts once on its own (docs/multilevel.md): a
+// parcel that came in through the top and bounces back up through the bottom
+// (off a bed below the region) is counted by the bottom face too, once.
+TEST(Coupling, EachInflowFaceCountsAParcelOnce) {
+  json doc = two_level();
+  doc["couplings"][0]["inflow_faces"] = {"+z", "-z"};
+  Levels s = make(doc);
+  auto& c = s.coarse();
+  const std::size_t q = above(c, 1).back();
+  const dp::FaceBalance& top = s.c->faces()[5];
+  const dp::FaceBalance& bottom = s.c->faces()[4];
+  double t = 0;
+  auto move_to = [&](double z) {
+    c.z[q] = z;
+    s.exchange(t += 1e-3);
+  };
+  move_to(0.025);  // in through the top
+  EXPECT_EQ(top.parcels, 1u);
+  EXPECT_EQ(bottom.parcels, 0u);
+  move_to(-0.005);  // out through the bottom...
+  move_to(0.005);   // ...and back in through it
+  EXPECT_EQ(bottom.parcels, 1u);
+  EXPECT_EQ(bottom.counted, dp::mass_units(c.mass[q]));
+  for (int k = 0; k < 2; ++k) {  // again through each face: neither counts it twice
+    move_to(-0.005);
+    move_to(0.005);
+    move_to(0.035);
+    move_to(0.025);
+  }
+  EXPECT_EQ(top.parcels, 1u);
+  EXPECT_EQ(bottom.parcels, 1u);
+  EXPECT_EQ(s.sim->flow.residual(1, s.fine()), 0);
 }
 
 TEST(Coupling, RemovesFineParticlesThatLeaveAndBooksTheFaceTheyCrossed) {
