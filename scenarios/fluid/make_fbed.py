@@ -19,6 +19,13 @@ cases (c) and (d), into scenarios/fluid/bed/:
                  cells) with four times the beads (158,464 at alpha = 1): is
                  a difference between the ratios the narrow column's (6
                  parcels across at alpha = 4)?
+  a{1,2,4}_c24.json  the beds of a{1,2,4}.json on cells of 24 mm (1 x 1 x 10:
+                 6 parcel diameters at alpha = 4, against 3 on the 12 mm
+                 cells) for 3 s: on 12 mm cells the alpha = 4 bed expands
+                 less than alpha = 1 and 2 whatever the walls, drag law and
+                 collision parameters; is it the cells' size against the
+                 parcels'? a{2,4}_c24_unscaled.json: the same without drag
+                 scaling, 0.8 s.
   w{1,2,4}.json  the beds of a{1,2,4}.json fluidised by water at U_W m/s
                  instead of air, for 2 s: a liquid-fluidised bed of these
                  beads expands homogeneously (no bubbles, no slugs), so its
@@ -116,6 +123,17 @@ def main():
             name, f"Fluidised bed, case (d), twice as wide: {4 * N_D} glass beads of 1 mm as {count} parcels of "
             f"alpha = {alpha}, 48 x 48 mm column, 12 mm cells, air at {U_D} m/s, Gidaspow drag.",
             0.048, 4, 0.012, 0.24, alpha, count, U_D, 0.8)
+    for alpha in (1, 2, 4):
+        for scaling in (True, False):
+            if alpha == 1 and not scaling:
+                continue
+            name = f"a{alpha}_c24" + ("" if scaling else "_unscaled")
+            count = N_D // alpha ** 3
+            docs[name] = scenario(
+                name, f"Fluidised bed, case (d), on larger cells: {N_D} glass beads of 1 mm as {count} parcels of "
+                f"alpha = {alpha}, 24 x 24 mm column, one column of 24 mm cells, air at {U_D} m/s, Gidaspow drag"
+                + ("" if scaling else ", coarse-grain drag scaling OFF") + ".",
+                0.024, 1, 0.024, 0.24, alpha, count, U_D, 3.0 if scaling else 0.8, scaling)
     for alpha in (1, 2, 4):
         name = f"w{alpha}"
         count = N_D // alpha ** 3
