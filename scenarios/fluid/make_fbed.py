@@ -105,17 +105,20 @@ def main():
             name, f"Fluidised bed, case (c): 5940 glass beads of 1 mm in a 12 x 12 mm column, 3 mm cells, "
             f"air at {u} m/s, Gidaspow drag.", 0.012, 4, 0.003, 0.12, 1, 5940, u, 0.6)
     # (d): 24 x 24 mm, 2 x 2 x 20 cells of 12 mm; the same mass at alpha = 1, 2, 4
-    for alpha in (1, 2, 4):
-        for scaling in (True, False):
-            if alpha == 1 and not scaling:
-                continue
-            name = f"a{alpha}" + ("" if scaling else "_unscaled")
-            count = N_D // alpha ** 3
-            docs[name] = scenario(
-                name, f"Fluidised bed, case (d): {N_D} glass beads of 1 mm as {count} parcels of alpha = {alpha}, "
-                f"24 x 24 mm column, 12 mm cells, air at {U_D} m/s, Gidaspow drag"
-                + ("" if scaling else ", coarse-grain drag scaling OFF") + ".",
-                0.024, 2, 0.012, 0.24, alpha, count, U_D, 0.8, scaling)
+    def ratios(suffix, case, cells_xy, cell_z, cells_text, duration):
+        """a{1,2,4}<suffix> with drag scaling, a{2,4}<suffix>_unscaled without it (0.8 s)."""
+        for alpha in (1, 2, 4):
+            for scaling in (True, False):
+                if alpha == 1 and not scaling:
+                    continue
+                name = f"a{alpha}{suffix}" + ("" if scaling else "_unscaled")
+                count = N_D // alpha ** 3
+                docs[name] = scenario(
+                    name, f"Fluidised bed, case (d){case}: {N_D} glass beads of 1 mm as {count} parcels of "
+                    f"alpha = {alpha}, 24 x 24 mm column, {cells_text}, air at {U_D} m/s, Gidaspow drag"
+                    + ("" if scaling else ", coarse-grain drag scaling OFF") + ".",
+                    0.024, cells_xy, cell_z, 0.24, alpha, count, U_D, duration if scaling else 0.8, scaling)
+    ratios("", "", 2, 0.012, "12 mm cells", 0.8)
     for alpha in (1, 2, 4):
         name = f"a{alpha}_wide"
         count = 4 * N_D // alpha ** 3
@@ -123,17 +126,7 @@ def main():
             name, f"Fluidised bed, case (d), twice as wide: {4 * N_D} glass beads of 1 mm as {count} parcels of "
             f"alpha = {alpha}, 48 x 48 mm column, 12 mm cells, air at {U_D} m/s, Gidaspow drag.",
             0.048, 4, 0.012, 0.24, alpha, count, U_D, 0.8)
-    for alpha in (1, 2, 4):
-        for scaling in (True, False):
-            if alpha == 1 and not scaling:
-                continue
-            name = f"a{alpha}_c24" + ("" if scaling else "_unscaled")
-            count = N_D // alpha ** 3
-            docs[name] = scenario(
-                name, f"Fluidised bed, case (d), on larger cells: {N_D} glass beads of 1 mm as {count} parcels of "
-                f"alpha = {alpha}, 24 x 24 mm column, one column of 24 mm cells, air at {U_D} m/s, Gidaspow drag"
-                + ("" if scaling else ", coarse-grain drag scaling OFF") + ".",
-                0.024, 1, 0.024, 0.24, alpha, count, U_D, 3.0 if scaling else 0.8, scaling)
+    ratios("_c24", ", on larger cells", 1, 0.024, "one column of 24 mm cells", 3.0)
     for alpha in (1, 2, 4):
         name = f"w{alpha}"
         count = N_D // alpha ** 3
