@@ -18,6 +18,15 @@ ContactScratch::ContactScratch(const ContactPipeline& pipeline)
       ci(ContactPipeline::kBatchSize),
       cj(ContactPipeline::kBatchSize) {}
 
+void PackedPositions::fill(const ParticleStore& s, std::size_t first, std::size_t last) {
+  const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data(), *r = s.radius.data();
+  Pair* out = xy_zr.data();
+  for (std::size_t k = first; k < last; ++k) {
+    out[2 * k] = Pair{x[k], y[k]};
+    out[2 * k + 1] = Pair{z[k], r[k]};
+  }
+}
+
 namespace {
 
 // History rows are a few doubles (3 for Mindlin, 6 with a rolling model):
@@ -157,6 +166,7 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
   const double* __restrict pwx = s.wx.data(); const double* __restrict pwy = s.wy.data();
   const double* __restrict pwz = s.wz.data();
   const double* __restrict pm = s.mass.data();
+  const PackedPositions::Pair* __restrict packed = sw.packed;
   uint32_t* __restrict entry = ts.entry.data();
   double* __restrict lever_i = ts.ci.data();
   double* __restrict lever_j = ts.cj.data();
@@ -185,12 +195,22 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     // rare contact that just opened, until a batch is full. Most entries of a
     // Verlet list are not in contact (S1: ~5 of 6), so a data-dependent
     // branch here mispredicts often.
+    // The positions come packed (PackedPositions): the same values and the
+    // same operations, in the same order, as from the store's arrays.
     uint32_t c = 0;
     for (; e < last && c < kBatch; ++e) {
       const uint32_t i = li[e], j = lj[e];
-      double dx, dy, dz;
-      separation(i, j, dx, dy, dz);
-      const double rsum = pr[i] + pr[j];
+      const PackedPositions::Pair* pi = packed + 2 * static_cast<std::size_t>(i);
+      const PackedPositions::Pair* pj = packed + 2 * static_cast<std::size_t>(j);
+      const PackedPositions::Pair xy = pi[0] - pj[0], zr_i = pi[1], zr_j = pj[1];
+      const PackedPositions::Pair dz_ = zr_i - zr_j, rsum_ = zr_i + zr_j;
+      double dx = xy[0], dy = xy[1], dz = dz_[0];
+      if constexpr (kPeriodic) {
+        dx = min_image(dx, per[0], inv_per[0]);
+        dy = min_image(dy, per[1], inv_per[1]);
+        dz = min_image(dz, per[2], inv_per[2]);
+      }
+      const double rsum = rsum_[1];
       const uint32_t in = (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
       if (touching[e] > in) {  // the contact opened: its history ends
         touching[e] = 0;

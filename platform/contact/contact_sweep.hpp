@@ -69,6 +69,27 @@ struct ContactScratch {
   std::vector<uint8_t> counted;
 };
 
+/// The particles' positions and radii packed for the pair sweep's overlap
+/// screen: per particle the pairs (x, y) and (z, r) of 16 bytes each, so
+/// that a list entry loads its two particles with four 16-byte loads instead
+/// of eight scalar ones from four arrays (the screen visits every entry of
+/// the list each step and was bound by its loads; docs/performance.md,
+/// 2026-12-05, fourth session). A copy of the store's x, y, z and radius,
+/// valid from fill() until the next change of either: the subdomain fills
+/// it right before each force evaluation. Values are copied, never
+/// recomputed, so the screen's arithmetic and results are those of the
+/// arrays. GCC's and Clang's generic vectors, lowered to plain loads where
+/// a target has no 16-byte registers.
+struct PackedPositions {
+  using Pair = double __attribute__((vector_size(16)));
+  std::vector<Pair> xy_zr;  ///< [2 k]: (x, y) of particle k; [2 k + 1]: (z, radius)
+  /// Size the array for n particles (no fill).
+  void resize(std::size_t n) { xy_zr.resize(2 * n); }
+  /// Copy particles [first, last) of the store (the array sized by resize()).
+  void fill(const ParticleStore& s, std::size_t first, std::size_t last);
+  std::size_t bytes() const { return xy_zr.capacity() * sizeof(Pair); }
+};
+
 /// The inputs of the pair sweep of one force evaluation.
 struct PairSweep {
   const ParticleStore* store;
@@ -85,6 +106,7 @@ struct PairSweep {
   uint32_t n_materials;
   double dt;
   bool record;  ///< append each contact's force to ContactScratch::records
+  const PackedPositions::Pair* packed;  ///< the store's positions and radii, packed and filled
 };
 
 /// The pair contacts of list entries [first, last). Forces on particles in

@@ -38,7 +38,7 @@ struct SubdomainStats {
 /// Bytes held by a subdomain's per-particle and per-contact arrays (their
 /// capacity), for the run summary and the memory benchmark.
 struct MemoryUse {
-  std::size_t particles = 0;        ///< the particle store
+  std::size_t particles = 0;        ///< the particle store and its packed positions (PackedPositions)
   std::size_t neighbor_lists = 0;   ///< pair and wall lists without their history
   std::size_t contact_history = 0;  ///< per-entry history rows of the pair and wall lists
   std::size_t threads = 0;          ///< the other threads' force arrays

@@ -428,9 +428,11 @@ void Subdomain::step_fused() {
   try {
     const bool reduce = take_pending_reduce(n);  // pending only with a pending kick
     const KickDrift how{dt, half, pending_half_, finish, stale ? nullptr : &nlist_, &body_forces_};
+    packed_.resize(n);
     pool_->run([&](int t) {
       const auto [first, last] = finish_forces(t, reduce, n);
       drift_counts_[static_cast<std::size_t>(t)] = kick_drift(store_, first, last, how);
+      packed_.fill(store_, first, last);  // the drifted positions, while in cache
     });
     if (reduce) finish_wall_stats();
     // reported as at the end of the last step, where the two-pass step found it
@@ -438,14 +440,16 @@ void Subdomain::step_fused() {
       for (const DriftCounts& c : drift_counts_)
         if (c.nonfinite != 0.0) throw_nonfinite("in the second half kick", time_, steps_);
     update_walls(time_ + dt);
+    bool packed_filled = true;
     if (rebuild_due(stale)) {
       exchange();
       rebuild_lists();
+      packed_filled = false;  // the store may have been re-ordered
     }
     // The forces; with threads, the other threads' sums and the wall
     // contacts are left to the next pass 1 (or synchronize()), as is the
     // second half kick: one fork/join and one sweep less per step.
-    contact_forces(true);
+    contact_forces(true, packed_filled);
   } catch (const PluginError& e) {
     rethrow_with_context(e, "the contact forces");
   }
@@ -531,7 +535,7 @@ void Subdomain::step_in_order() {
 PairSweep Subdomain::pair_sweep() const {
   return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), class_pairs_.data(), class_rolling_.data(),
           pair_class_.data(), static_cast<uint32_t>(class_pairs_.size()), static_cast<uint32_t>(materials_.size()),
-          dt_, record_};
+          dt_, record_, packed_.xy_zr.data()};
 }
 
 WallSweep Subdomain::wall_sweep() {
@@ -540,13 +544,13 @@ WallSweep Subdomain::wall_sweep() {
           pipeline_.get(), dt_, forces_time_, wall_time_, record_};
 }
 
-void Subdomain::contact_forces(bool defer_reduce) {
+void Subdomain::contact_forces(bool defer_reduce, bool packed_filled) {
   forces_time_ = time_;
   contacts_counted_ = false;
   contacts_collected_ = false;
   last_max_overlap_ratio_ = 0;
   for (auto& ts : scratch_) ts.records.clear();
-  pair_forces(defer_reduce);
+  pair_forces(defer_reduce, packed_filled);
   if (reduce_pending_) {
     prune_removed_walls();  // the walls' forces follow in the next pass 1 or synchronize(), per particle range
   } else {
@@ -554,10 +558,14 @@ void Subdomain::contact_forces(bool defer_reduce) {
   }
 }
 
-void Subdomain::pair_forces(bool defer_reduce) {
+void Subdomain::pair_forces(bool defer_reduce, bool packed_filled) {
   ParticleStore& s = store_;
   const int nt = threads();
   const bool far = far_active_;
+  if (!packed_filled) {
+    packed_.resize(s.size());
+    pool_->for_range(s.size(), [&](std::size_t first, std::size_t last, int) { packed_.fill(s, first, last); });
+  }
   const ForceAccumulator direct = ForceAccumulator::of(s);
   const PairSweep sweep = pair_sweep();
   if (nt > 1) {
@@ -628,6 +636,7 @@ std::vector<const std::vector<ContactRecord>*> Subdomain::contact_records() cons
 
 MemoryUse Subdomain::memory_use() const {
   MemoryUse m = list_memory(store_, nlist_, wall_lists_);
+  m.particles += packed_.bytes();
   m.threads = partition_.bytes();
   return m;
 }

@@ -257,8 +257,10 @@ class Subdomain {
   bool rebuild_due(bool stale);
   /// Add particle-pair and wall contact forces; with defer_reduce the other
   /// threads' partial sums and the wall contacts are left to the next pass.
-  void contact_forces(bool defer_reduce);
-  void pair_forces(bool defer_reduce);
+  /// packed_filled: packed_ holds the store's positions already (pass 1 of
+  /// step_fused filled it), else the pair sweep fills it first.
+  void contact_forces(bool defer_reduce, bool packed_filled = false);
+  void pair_forces(bool defer_reduce, bool packed_filled);
   void wall_forces();
   PairSweep pair_sweep() const;
   WallSweep wall_sweep();
@@ -307,6 +309,7 @@ class Subdomain {
   double last_max_overlap_ratio_ = 0;
   std::vector<ContactScratch> scratch_;  ///< per thread
   ForcePartition partition_;
+  PackedPositions packed_;  ///< the pair screen's copy of the positions, filled before each force evaluation
   std::vector<DriftCounts> drift_counts_;  ///< per thread, of pass 1
   std::vector<double> nonfinite_counts_;   ///< per thread, of a second half kick
   bool reduce_pending_ = false;

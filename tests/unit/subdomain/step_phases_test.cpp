@@ -81,6 +81,44 @@ TEST(StepPhases, EmptyHooksGiveTheFastPathsResultsBitForBit) {
   }
 }
 
+TEST(StepPhases, TheFastPathFollowsAStoreReorderedAtAListBuild) {
+  // The fused step copies the drifted positions for the pair screen
+  // (PackedPositions) in its first sweep; a list build that re-orders the
+  // store in between must not leave the screen the old order. 16 x 16 x 20
+  // particles (re-ordering needs 5000 or more), re-ordered at every build;
+  // the hooked path copies the positions right before the forces.
+  json doc = column();
+  const double a = 1.02 * kD;
+  doc["walls"][0]["max"] = {16 * a, 16 * a, 40 * a};
+  doc["subdomains"][0]["insert"][0]["region"]["box"]["max"] = {16 * a, 16 * a, 20 * a};
+  for (int threads : {1, 2}) {
+    auto fast = prepared(doc, threads);
+    auto hooked = prepared(doc, threads);
+    Subdomain& f = *fast->subdomains[0];
+    Subdomain& h = *hooked->subdomains[0];
+    f.set_reorder_every(1);
+    h.set_reorder_every(1);
+    h.add_hook(Phase::end_of_step, {"nothing", [](StepContext&) {}});
+    for (int k = 0; k < 2500; ++k) {
+      f.step_deferred();
+      h.step_deferred();
+    }
+    const auto& p = f.store();
+    const auto& q = h.store();
+    ASSERT_EQ(p.size(), 5120u);
+    std::printf("%d thread(s): %zu list builds, %zu contacts\n", threads, f.neighbor_builds(), f.stats().contacts);
+    EXPECT_GT(f.neighbor_builds(), 2u);  // re-ordered after the first build too
+    EXPECT_GT(f.stats().contacts, 1000u);
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      ASSERT_EQ(p.id[k], q.id[k]) << threads << " threads, particle " << k;
+      ASSERT_EQ(p.x[k], q.x[k]) << threads << " threads, particle " << k;
+      ASSERT_EQ(p.z[k], q.z[k]);
+      ASSERT_EQ(p.vz[k], q.vz[k]);
+    }
+    EXPECT_EQ(f.stats().contacts, h.stats().contacts);
+  }
+}
+
 TEST(StepPhases, HooksRunInPhaseOrderAndSeeTheirStep) {
   auto sim = prepared(column(), 2);
   Subdomain& sd = *sim->subdomains[0];
