@@ -31,6 +31,9 @@ What is measured (see docs/benchmarks.md, "A/B gate between two builds"):
   `HIGHER>2%` above 1.02. The count is deterministic to far below 1 %, so it resolves what a 3 % wall-clock gate
   cannot on a noisy machine. It includes setup (scenario load, plugins, insertion, the first neighbour build) and,
   on S1/S2, only the start of the fall from the lattice (few contacts); the bed is contact-heavy from step 1.
+  --callgrind-from K: instead, the steps K+1 .. K+S alone (S = --callgrind-steps), as the difference of a run of
+  K + S steps and one of K steps: no setup (scenario load, plugin loading and relocation, the initial overlap
+  check), which a binary with more plugin libraries pays once per run; K = 2000 counts the benchmarks' timed window.
 
 Usage:
     python3 bench/ab.py --old OLD/build/bin/domel --new NEW/build/bin/domel            # the full gate's timing
@@ -70,7 +73,7 @@ SLOWER = 0.97          # flag new/old throughput below this
 HIGHER_IR = 1.02       # flag new/old instructions above this
 
 CSV_FIELDS = [
-    "timestamp", "mode", "case", "N_requested", "N_actual", "threads", "binary", "rep", "ok", "steps",
+    "timestamp", "mode", "case", "N_requested", "N_actual", "threads", "binary", "rep", "ok", "steps", "first_step",
     "timed_steps", "timed_wall_s", "particle_steps_per_s", "timed_cpu_s", "particle_steps_per_cpu_s",
     "process_wall_s", "process_cpu_s", "load1_start", "load1_end", "instructions_Ir",
     "mean_contacts_per_particle", "ke_translational_final_J", "neighbor_builds_total", "peak_rss_bytes",
@@ -142,12 +145,24 @@ def run_timed_case(binary, which, case, n, threads, rep, workdir, timeout, env):
     return row
 
 
-def run_callgrind_case(binary, which, case, n, nsteps, workdir, timeout, env, valgrind):
+def run_callgrind_case(binary, which, case, n, nsteps, workdir, timeout, env, valgrind, first=0):
+    """Ir of one binary on one case: the whole process of nsteps steps (first = 0), or the steps first+1 ..
+    first+nsteps alone (the difference of a run of first + nsteps steps and one of first steps)."""
+    if first > 0:
+        rows = [run_callgrind_case(binary, which, case, n, k, workdir, timeout, env, valgrind)
+                for k in (first, first + nsteps)]
+        row = dict(rows[1])
+        row.update(steps=nsteps, first_step=first + 1, process_wall_s=rows[0]["process_wall_s"] + rows[1]["process_wall_s"])
+        if not (rows[0].get("ok") and rows[1].get("ok")):
+            row.update(ok=0, error=rows[0].get("error") or rows[1].get("error"))
+        else:
+            row["instructions_Ir"] = rows[1]["instructions_Ir"] - rows[0]["instructions_Ir"]
+        return row
     rolling = CASES[case][1]
     wd = os.path.join(workdir, "%s_%s" % (case, which))
     os.makedirs(wd, exist_ok=True)
     scen = run_s1.deck_scenario(n, wd, rolling)
-    outdir = os.path.join(wd, "callgrind_N%d" % n)
+    outdir = os.path.join(wd, "callgrind_N%d_%d" % (n, nsteps))
     log = outdir + ".screen"
     cg_out = outdir + ".callgrind.out"
     row = {"mode": "callgrind", "case": case, "N_requested": n, "threads": 1, "binary": which, "rep": 1,
@@ -276,8 +291,13 @@ def print_tables(rows):
     high = []
     if keys:
         print()
-        print("Instructions (callgrind Ir, one thread, whole process: setup + the first %s steps)" %
-              "/".join(sorted({str(r["steps"]) for r in rows if r.get("mode") == "callgrind"})))
+        firsts = sorted({r.get("first_step", 1) for r in rows if r.get("mode") == "callgrind"})
+        steps = "/".join(sorted({str(r["steps"]) for r in rows if r.get("mode") == "callgrind"}))
+        if firsts == [1]:
+            print("Instructions (callgrind Ir, one thread, whole process: setup + the first %s steps)" % steps)
+        else:
+            print("Instructions (callgrind Ir, one thread, of the %s steps from step %s on alone: the difference "
+                  "of two runs, so setup is not in it)" % (steps, "/".join(str(f) for f in firsts)))
         lines = []
         for key in keys:
             o = pick(rows, "callgrind", key, "old", "instructions_Ir")
@@ -310,6 +330,10 @@ def main(argv=None):
                     help="also count instructions: each case once per binary under valgrind's callgrind")
     ap.add_argument("--callgrind-steps", type=int, default=300, help="steps of a callgrind run (default 300)")
     ap.add_argument("--callgrind-size", type=int, default=10000, help="N of the callgrind runs (default 10000)")
+    ap.add_argument("--callgrind-from", type=int, default=0,
+                    help="count only the steps after this many: each binary runs --callgrind-from and "
+                         "--callgrind-from + --callgrind-steps steps, and the difference is compared (setup, "
+                         "plugin loading and the first steps left out; default 0: the whole process)")
     ap.add_argument("--timeout", type=float, default=900, help="per timed run, s (default 900)")
     ap.add_argument("--callgrind-timeout", type=float, default=3600, help="per callgrind run, s (default 3600)")
     ap.add_argument("--results", default=os.path.join(HERE, "results"), help="CSV folder (default bench/results)")
@@ -324,8 +348,9 @@ def main(argv=None):
         if not os.path.isfile(p) or not os.access(p, os.X_OK):
             ap.error("--%s: %s is not an executable file" % (name, p))
         setattr(args, name, p)
-    if args.reps < 0 or args.callgrind_steps < 1 or any(n < 2 for n in args.sizes + [args.callgrind_size]):
-        ap.error("--reps must be >= 0, --callgrind-steps >= 1 and every size >= 2")
+    if args.reps < 0 or args.callgrind_steps < 1 or args.callgrind_from < 0 or \
+            any(n < 2 for n in args.sizes + [args.callgrind_size]):
+        ap.error("--reps must be >= 0, --callgrind-steps >= 1, --callgrind-from >= 0 and every size >= 2")
     if any(t < 1 for t in args.threads):
         ap.error("--threads expects counts >= 1")
     if args.reps == 0 and not args.callgrind:
@@ -371,7 +396,8 @@ def main(argv=None):
         ("timed: sizes %s, threads %s, %d rep(s) per binary" % (" ".join(map(str, args.sizes)),
                                                               " ".join(map(str, args.threads)), args.reps))
         if args.reps else "no timed runs",
-        ("callgrind: N = %d, %d steps, 1 thread" % (args.callgrind_size, args.callgrind_steps))
+        ("callgrind: N = %d, %d steps%s, 1 thread" % (args.callgrind_size, args.callgrind_steps,
+                                                       " after %d" % args.callgrind_from if args.callgrind_from else ""))
         if args.callgrind else "no callgrind", workdir))
     if bad_plugins:
         print("a binary could not list its plugins; the runs may fail", file=sys.stderr)
@@ -426,7 +452,8 @@ def main(argv=None):
                 set_deck(case, bed_dir)
                 for which in BINARIES:
                     record(run_callgrind_case(getattr(args, which), which, case, args.callgrind_size,
-                                              args.callgrind_steps, workdir, args.callgrind_timeout, env, valgrind))
+                                              args.callgrind_steps, workdir, args.callgrind_timeout, env, valgrind,
+                                              args.callgrind_from))
 
     slow, diff, high = print_tables(rows)
     print()

@@ -5,6 +5,10 @@
 
 #include "core/error.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -19,11 +23,12 @@ ContactScratch::ContactScratch(const ContactPipeline& pipeline)
       cj(ContactPipeline::kBatchSize) {}
 
 void PackedPositions::fill(const ParticleStore& s, std::size_t first, std::size_t last) {
-  const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data(), *r = s.radius.data();
-  Pair* out = xy_zr.data();
+  double* out = xyzr.data();
   for (std::size_t k = first; k < last; ++k) {
-    out[2 * k] = Pair{x[k], y[k]};
-    out[2 * k + 1] = Pair{z[k], r[k]};
+    out[4 * k] = s.x[k];
+    out[4 * k + 1] = s.y[k];
+    out[4 * k + 2] = s.z[k];
+    out[4 * k + 3] = s.radius[k];
   }
 }
 
@@ -145,6 +150,39 @@ void group_by_key(uint32_t c, uint32_t n_keys, KeyOf&& key, std::vector<uint32_t
   for (uint32_t q = 0; q < c; ++q) slot_of[q] = count[slot_of[q]]++;
 }
 
+/// 1 when the spheres of two packed entries overlap: |x_i - x_j|^2 <
+/// (r_i + r_j)^2, the separation's squares summed x, y, then z (the same
+/// operations in the same order as on the store's arrays, so the same
+/// result bit for bit). With SSE2 (every x86-64) on 16-byte registers: the
+/// (x, y) difference and its squares in one register each, the horizontal
+/// sum and the radii's square by a lane copy.
+template <bool kPeriodic>
+inline uint32_t overlaps(const PackedPositions::Pair* pi, const PackedPositions::Pair* pj, const double* per,
+                         const double* inv_per) {
+#if defined(__SSE2__)
+  if constexpr (!kPeriodic) {
+    const __m128d xy = _mm_sub_pd(pi[0], pj[0]);                        // (dx, dy)
+    const __m128d zr_i = pi[1], zr_j = pj[1];
+    const __m128d u = _mm_move_sd(_mm_add_pd(zr_i, zr_j), _mm_sub_pd(zr_i, zr_j));  // (dz, r_i + r_j)
+    const __m128d sq = _mm_mul_pd(xy, xy);                              // (dx^2, dy^2)
+    const __m128d u2 = _mm_mul_pd(u, u);                                // (dz^2, (r_i + r_j)^2)
+    const __m128d dy2 = _mm_castsi128_pd(_mm_shuffle_epi32(_mm_castpd_si128(sq), 0xEE));
+    const __m128d rsum2 = _mm_castsi128_pd(_mm_shuffle_epi32(_mm_castpd_si128(u2), 0xEE));
+    return static_cast<uint32_t>(_mm_comilt_sd(_mm_add_sd(_mm_add_sd(sq, dy2), u2), rsum2));
+  }
+#endif
+  const PackedPositions::Pair xy = pi[0] - pj[0], zr_i = pi[1], zr_j = pj[1];
+  const PackedPositions::Pair dz_ = zr_i - zr_j, rsum_ = zr_i + zr_j;
+  double dx = xy[0], dy = xy[1], dz = dz_[0];
+  if constexpr (kPeriodic) {
+    dx = min_image(dx, per[0], inv_per[0]);
+    dy = min_image(dy, per[1], inv_per[1]);
+    dz = min_image(dz, per[2], inv_per[2]);
+  }
+  const double rsum = rsum_[1];
+  return (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
+}
+
 template <bool kZoned, bool kTorque, bool kMasses, bool kMixed, bool kPeriodic>
 void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, ContactScratch& ts, std::size_t own_lo,
                 std::size_t own_hi, const ForceAccumulator& own, const ForceAccumulator& shared) {
@@ -197,27 +235,22 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     // branch here mispredicts often.
     // The positions come packed (PackedPositions): the same values and the
     // same operations, in the same order, as from the store's arrays.
+    // An entry adds at most one contact, so kBatch - c entries cannot
+    // overfill the batch: the inner loop tests only its end.
     uint32_t c = 0;
-    for (; e < last && c < kBatch; ++e) {
+    while (e < last && c < kBatch) {
+    const std::size_t stop = std::min<std::size_t>(last, e + (kBatch - c));
+    for (; e < stop; ++e) {
       const uint32_t i = li[e], j = lj[e];
-      const PackedPositions::Pair* pi = packed + 2 * static_cast<std::size_t>(i);
-      const PackedPositions::Pair* pj = packed + 2 * static_cast<std::size_t>(j);
-      const PackedPositions::Pair xy = pi[0] - pj[0], zr_i = pi[1], zr_j = pj[1];
-      const PackedPositions::Pair dz_ = zr_i - zr_j, rsum_ = zr_i + zr_j;
-      double dx = xy[0], dy = xy[1], dz = dz_[0];
-      if constexpr (kPeriodic) {
-        dx = min_image(dx, per[0], inv_per[0]);
-        dy = min_image(dy, per[1], inv_per[1]);
-        dz = min_image(dz, per[2], inv_per[2]);
-      }
-      const double rsum = rsum_[1];
-      const uint32_t in = (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
+      const uint32_t in = overlaps<kPeriodic>(packed + 2 * static_cast<std::size_t>(i),
+                                              packed + 2 * static_cast<std::size_t>(j), per, inv_per);
       if (touching[e] > in) {  // the contact opened: its history ends
         touching[e] = 0;
         for (uint32_t h = 0; h < stride; ++h) list_history[e * stride + h] = 0.0;
       }
       entry[c] = static_cast<uint32_t>(e);
       c += in;
+    }
     }
     if (c == 0) continue;
     // Several classes of material pairs: the batch's contacts grouped by

@@ -15,7 +15,8 @@
 // Forces: F_i = F_n n + F_t, F_j = -F_i. Torques: T_i = -c_i n x F_t + M,
 // T_j = -c_j n x F_t - M (M: rolling/twisting couple on i).
 //
-// Fields: reads the store's x, y, z, v, w, radius, mass; adds into the
+// Fields: reads the store's x, y, z, v, w, radius, mass (the pair screen
+// its packed copy of x, y, z and radius, PackedPositions); adds into the
 // accumulators' f and t; reads and writes the lists' touching flags and
 // history rows.
 #pragma once
@@ -81,14 +82,17 @@ struct ContactScratch {
 /// arrays. GCC's and Clang's generic vectors, lowered to plain loads where
 /// a target has no 16-byte registers.
 struct PackedPositions {
-  using Pair = double __attribute__((vector_size(16)));
-  std::vector<Pair> xy_zr;  ///< [2 k]: (x, y) of particle k; [2 k + 1]: (z, radius)
+  /// Two doubles in one 16-byte register; may alias the doubles of xyzr.
+  using Pair = double __attribute__((vector_size(16), may_alias));
+  std::vector<double> xyzr;  ///< [4 k, 4 k + 4): x, y, z and radius of particle k (16-byte aligned)
   /// Size the array for n particles (no fill).
-  void resize(std::size_t n) { xy_zr.resize(2 * n); }
+  void resize(std::size_t n) { xyzr.resize(4 * n); }
   /// Copy particles [first, last) of the store (the array sized by resize()).
   void fill(const ParticleStore& s, std::size_t first, std::size_t last);
-  std::size_t bytes() const { return xy_zr.capacity() * sizeof(Pair); }
+  const Pair* pairs() const { return reinterpret_cast<const Pair*>(xyzr.data()); }
+  std::size_t bytes() const { return xyzr.capacity() * sizeof(double); }
 };
+static_assert(__STDCPP_DEFAULT_NEW_ALIGNMENT__ >= 16, "PackedPositions reads xyzr as aligned 16-byte pairs");
 
 /// The inputs of the pair sweep of one force evaluation.
 struct PairSweep {

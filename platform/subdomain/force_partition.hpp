@@ -45,11 +45,11 @@ class ForcePartition {
   };
 
   /// The estimated cost of the force evaluation's pieces, in units of one
-  /// pair-list entry's overlap screen (measured on S2 at 10k,
-  /// docs/performance.md): a pair contact (contact kernels, scatter), a
+  /// pair-list entry's overlap screen (measured on S1 and S2 at 10k on two
+  /// threads, docs/performance.md): a pair contact (contact kernels, scatter), a
   /// wall-list entry (its gap test), a wall contact. The threads' split and
   /// the ranks' decomposition (Subdomain::rank_costs) weigh the work alike.
-  static constexpr std::uint64_t kPairContactCost = 12;
+  static constexpr std::uint64_t kPairContactCost = 15;
   static constexpr std::uint64_t kWallEntryCost = 1;
   static constexpr std::uint64_t kWallContactCost = 6;
 

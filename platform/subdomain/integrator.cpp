@@ -31,7 +31,7 @@ enum Reset { kNoReset = 0, kGravity = 1, kGravityExternal = 2 };
 /// kick (of half_prev, with the same forces) and its finiteness check,
 /// counted into `bad`: one sweep over the store per step instead of two.
 /// The arithmetic is that of the two passes, value by value.
-template <bool kCheck, bool kFinish, int kReset>
+template <bool kCheck, bool kFinish, int kReset, bool kPack>
 void kick_drift_kernel(std::size_t first, std::size_t last, double dt, double half, double half_prev,
                        const double g[3], double* __restrict x, double* __restrict y, double* __restrict z,
                        double* __restrict vx, double* __restrict vy, double* __restrict vz, double* __restrict wx,
@@ -40,7 +40,8 @@ void kick_drift_kernel(std::size_t first, std::size_t last, double dt, double ha
                        const double* __restrict im, const double* __restrict ii, const double* __restrict m,
                        const double* __restrict ex, const double* __restrict ey, const double* __restrict ez,
                        const double* __restrict x0, const double* __restrict y0, const double* __restrict z0,
-                       double limit2, double limit2_far, DriftCounts& out) {
+                       const double* __restrict r, double* __restrict pack, double limit2, double limit2_far,
+                       DriftCounts& out) {
   const double g0 = g[0], g1 = g[1], g2 = g[2];
   double far = 0.0, tier = 0.0, bad_count = 0.0;
   for (std::size_t k = first; k < last; ++k) {
@@ -60,6 +61,9 @@ void kick_drift_kernel(std::size_t first, std::size_t last, double dt, double ha
     vx[k] = ux; vy[k] = uy; vz[k] = uz;
     wx[k] = ox; wy[k] = oy; wz[k] = oz;
     x[k] = px; y[k] = py; z[k] = pz;
+    if constexpr (kPack) {
+      pack[4 * k] = px; pack[4 * k + 1] = py; pack[4 * k + 2] = pz; pack[4 * k + 3] = r[k];
+    }
     if constexpr (kCheck) {
       const double dx = px - x0[k], dy = py - y0[k], dz = pz - z0[k];
       const double d2 = dx * dx + dy * dy + dz * dz;
@@ -80,13 +84,19 @@ void kick_drift_kernel(std::size_t first, std::size_t last, double dt, double ha
   out.nonfinite = bad_count;
 }
 
-using KernelFn = decltype(&kick_drift_kernel<true, true, kGravity>);
+using KernelFn = decltype(&kick_drift_kernel<true, true, kGravity, false>);
 
-template <bool kCheck, bool kFinish>
+template <bool kCheck, bool kFinish, bool kPack>
 KernelFn pick_reset(int reset) {
-  if (reset == kGravity) return &kick_drift_kernel<kCheck, kFinish, kGravity>;
-  if (reset == kGravityExternal) return &kick_drift_kernel<kCheck, kFinish, kGravityExternal>;
-  return &kick_drift_kernel<kCheck, kFinish, kNoReset>;
+  if (reset == kGravity) return &kick_drift_kernel<kCheck, kFinish, kGravity, kPack>;
+  if (reset == kGravityExternal) return &kick_drift_kernel<kCheck, kFinish, kGravityExternal, kPack>;
+  return &kick_drift_kernel<kCheck, kFinish, kNoReset, kPack>;
+}
+
+template <bool kPack>
+KernelFn pick(bool check, bool finish, int reset) {
+  return check ? (finish ? pick_reset<true, true, kPack>(reset) : pick_reset<true, false, kPack>(reset))
+               : (finish ? pick_reset<false, true, kPack>(reset) : pick_reset<false, false, kPack>(reset));
 }
 
 double kick_check_kernel(std::size_t first, std::size_t last, double half, const double* __restrict x,
@@ -125,8 +135,7 @@ void BodyForces::apply(ParticleStore& s, std::size_t first, std::size_t last) co
 DriftCounts kick_drift(ParticleStore& s, std::size_t first, std::size_t last, const KickDrift& how) {
   const int reset = how.reset ? (s.has_external_force() ? kGravityExternal : kGravity) : kNoReset;
   const bool check = how.check != nullptr;
-  const KernelFn kernel = check ? (how.finish ? pick_reset<true, true>(reset) : pick_reset<true, false>(reset))
-                                : (how.finish ? pick_reset<false, true>(reset) : pick_reset<false, false>(reset));
+  const KernelFn kernel = how.pack ? pick<true>(check, how.finish, reset) : pick<false>(check, how.finish, reset);
   static const double kNoGravity[3] = {0, 0, 0};
   const double* g = how.reset ? how.reset->gravity : kNoGravity;
   const double* ex = s.has_external_force() ? s.ext_fx.data() : nullptr;
@@ -137,7 +146,7 @@ DriftCounts kick_drift(ParticleStore& s, std::size_t first, std::size_t last, co
          s.vy.data(), s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(),
          s.tx.data(), s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data(), s.mass.data(), ex, ey, ez,
          check ? how.check->x0() : nullptr, check ? how.check->y0() : nullptr, check ? how.check->z0() : nullptr,
-         check ? how.check->rebuild_displacement2() : 0.0, check ? how.check->far_tier_displacement2() : 0.0, out);
+         s.radius.data(), how.pack, check ? how.check->rebuild_displacement2() : 0.0, check ? how.check->far_tier_displacement2() : 0.0, out);
   return out;
 }
 

@@ -46,6 +46,9 @@ struct KickDrift {
   bool finish = false;       ///< do the previous step's second half kick first
   const NeighborList* check = nullptr;  ///< displacements since this list's build (null: no check)
   const BodyForces* reset = nullptr;    ///< reset the forces to the body forces (null: leave them)
+  /// Copy the drifted x, y, z and the radius into these 4 doubles per
+  /// particle (PackedPositions::xyzr, sized for the store; null: no copy).
+  double* pack = nullptr;
 };
 
 /// Pass 1 of a step over particles [first, last).

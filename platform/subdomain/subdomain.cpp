@@ -427,12 +427,12 @@ void Subdomain::step_fused() {
   if (gravity_) gravity_->at(time_ + dt, body_forces_.gravity);  // the reset below is to the forces at t + dt
   try {
     const bool reduce = take_pending_reduce(n);  // pending only with a pending kick
-    const KickDrift how{dt, half, pending_half_, finish, stale ? nullptr : &nlist_, &body_forces_};
     packed_.resize(n);
+    const KickDrift how{dt, half, pending_half_, finish, stale ? nullptr : &nlist_, &body_forces_,
+                        packed_.xyzr.data()};
     pool_->run([&](int t) {
       const auto [first, last] = finish_forces(t, reduce, n);
       drift_counts_[static_cast<std::size_t>(t)] = kick_drift(store_, first, last, how);
-      packed_.fill(store_, first, last);  // the drifted positions, while in cache
     });
     if (reduce) finish_wall_stats();
     // reported as at the end of the last step, where the two-pass step found it
@@ -535,7 +535,7 @@ void Subdomain::step_in_order() {
 PairSweep Subdomain::pair_sweep() const {
   return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), class_pairs_.data(), class_rolling_.data(),
           pair_class_.data(), static_cast<uint32_t>(class_pairs_.size()), static_cast<uint32_t>(materials_.size()),
-          dt_, record_, packed_.xy_zr.data()};
+          dt_, record_, packed_.pairs()};
 }
 
 WallSweep Subdomain::wall_sweep() {
