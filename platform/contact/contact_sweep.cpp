@@ -156,31 +156,38 @@ void group_by_key(uint32_t c, uint32_t n_keys, KeyOf&& key, std::vector<uint32_t
 /// result bit for bit). With SSE2 (every x86-64) on 16-byte registers: the
 /// (x, y) difference and its squares in one register each, the horizontal
 /// sum and the radii's square by a lane copy.
+/// A contact of list entry e opened: it is no longer touching and its
+/// history ends. Rare, and out of line, so that the screen's loop keeps no
+/// history pointer of its own.
+[[gnu::noinline]] void opened(uint8_t* touching, double* history, std::size_t e, uint32_t stride) {
+  touching[e] = 0;
+  for (uint32_t h = 0; h < stride; ++h) history[e * stride + h] = 0.0;
+}
+
 template <bool kPeriodic>
-inline uint32_t overlaps(const PackedPositions::Pair* pi, const PackedPositions::Pair* pj, const double* per,
-                         const double* inv_per) {
+inline bool overlaps(const double* xyzr, std::size_t i, std::size_t j, const double* per, const double* inv_per) {
+  const double* pi = xyzr + 4 * i;
+  const double* pj = xyzr + 4 * j;
 #if defined(__SSE2__)
   if constexpr (!kPeriodic) {
-    const __m128d xy = _mm_sub_pd(pi[0], pj[0]);                        // (dx, dy)
-    const __m128d zr_i = pi[1], zr_j = pj[1];
+    const __m128d xy = _mm_sub_pd(_mm_load_pd(pi), _mm_load_pd(pj));   // (dx, dy)
+    const __m128d zr_i = _mm_load_pd(pi + 2), zr_j = _mm_load_pd(pj + 2);
     const __m128d u = _mm_move_sd(_mm_add_pd(zr_i, zr_j), _mm_sub_pd(zr_i, zr_j));  // (dz, r_i + r_j)
     const __m128d sq = _mm_mul_pd(xy, xy);                              // (dx^2, dy^2)
     const __m128d u2 = _mm_mul_pd(u, u);                                // (dz^2, (r_i + r_j)^2)
     const __m128d dy2 = _mm_castsi128_pd(_mm_shuffle_epi32(_mm_castpd_si128(sq), 0xEE));
     const __m128d rsum2 = _mm_castsi128_pd(_mm_shuffle_epi32(_mm_castpd_si128(u2), 0xEE));
-    return static_cast<uint32_t>(_mm_comilt_sd(_mm_add_sd(_mm_add_sd(sq, dy2), u2), rsum2));
+    return _mm_comilt_sd(_mm_add_sd(_mm_add_sd(sq, dy2), u2), rsum2) != 0;
   }
 #endif
-  const PackedPositions::Pair xy = pi[0] - pj[0], zr_i = pi[1], zr_j = pj[1];
-  const PackedPositions::Pair dz_ = zr_i - zr_j, rsum_ = zr_i + zr_j;
-  double dx = xy[0], dy = xy[1], dz = dz_[0];
+  double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
   if constexpr (kPeriodic) {
     dx = min_image(dx, per[0], inv_per[0]);
     dy = min_image(dy, per[1], inv_per[1]);
     dz = min_image(dz, per[2], inv_per[2]);
   }
-  const double rsum = rsum_[1];
-  return (dx * dx + dy * dy + dz * dz < rsum * rsum) ? 1u : 0u;
+  const double rsum = pi[3] + pj[3];
+  return dx * dx + dy * dy + dz * dz < rsum * rsum;
 }
 
 template <bool kZoned, bool kTorque, bool kMasses, bool kMixed, bool kPeriodic>
@@ -204,7 +211,7 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
   const double* __restrict pwx = s.wx.data(); const double* __restrict pwy = s.wy.data();
   const double* __restrict pwz = s.wz.data();
   const double* __restrict pm = s.mass.data();
-  const PackedPositions::Pair* __restrict packed = sw.packed;
+  const double* __restrict packed = sw.packed;
   uint32_t* __restrict entry = ts.entry.data();
   double* __restrict lever_i = ts.ci.data();
   double* __restrict lever_j = ts.cj.data();
@@ -237,21 +244,18 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     // same operations, in the same order, as from the store's arrays.
     // An entry adds at most one contact, so kBatch - c entries cannot
     // overfill the batch: the inner loop tests only its end.
-    uint32_t c = 0;
-    while (e < last && c < kBatch) {
-    const std::size_t stop = std::min<std::size_t>(last, e + (kBatch - c));
-    for (; e < stop; ++e) {
-      const uint32_t i = li[e], j = lj[e];
-      const uint32_t in = overlaps<kPeriodic>(packed + 2 * static_cast<std::size_t>(i),
-                                              packed + 2 * static_cast<std::size_t>(j), per, inv_per);
-      if (touching[e] > in) {  // the contact opened: its history ends
-        touching[e] = 0;
-        for (uint32_t h = 0; h < stride; ++h) list_history[e * stride + h] = 0.0;
+    std::size_t filled = 0;  // a full-width count: it indexes entry[] with no extension
+    while (e < last && filled < kBatch) {
+      const std::size_t stop = std::min<std::size_t>(last, e + (kBatch - filled));
+      for (; e < stop; ++e) {
+        const uint32_t i = li[e], j = lj[e];
+        const bool in = overlaps<kPeriodic>(packed, i, j, per, inv_per);
+        if (touching[e] > static_cast<uint8_t>(in)) opened(touching, list_history, e, stride);
+        entry[filled] = static_cast<uint32_t>(e);
+        filled += in;
       }
-      entry[c] = static_cast<uint32_t>(e);
-      c += in;
     }
-    }
+    const auto c = static_cast<uint32_t>(filled);
     if (c == 0) continue;
     // Several classes of material pairs: the batch's contacts grouped by
     // class, so that each run is evaluated with its own constants.

@@ -71,28 +71,24 @@ struct ContactScratch {
 };
 
 /// The particles' positions and radii packed for the pair sweep's overlap
-/// screen: per particle the pairs (x, y) and (z, r) of 16 bytes each, so
-/// that a list entry loads its two particles with four 16-byte loads instead
-/// of eight scalar ones from four arrays (the screen visits every entry of
-/// the list each step and was bound by its loads; docs/performance.md,
+/// screen: per particle x, y, z and radius in one 32-byte row, so that a
+/// list entry loads its two particles with four 16-byte loads instead of
+/// eight scalar ones from four arrays (the screen visits every entry of the
+/// list each step and was bound by its loads; docs/performance.md,
 /// 2026-12-05, fourth session). A copy of the store's x, y, z and radius,
-/// valid from fill() until the next change of either: the subdomain fills
-/// it right before each force evaluation. Values are copied, never
-/// recomputed, so the screen's arithmetic and results are those of the
-/// arrays. GCC's and Clang's generic vectors, lowered to plain loads where
-/// a target has no 16-byte registers.
+/// valid from its fill until the next change of either: the subdomain fills
+/// it right before each force evaluation (the fused step's first sweep
+/// writes it as it drifts). Values are copied, never recomputed, so the
+/// screen's arithmetic and results are those of the arrays.
 struct PackedPositions {
-  /// Two doubles in one 16-byte register; may alias the doubles of xyzr.
-  using Pair = double __attribute__((vector_size(16), may_alias));
   std::vector<double> xyzr;  ///< [4 k, 4 k + 4): x, y, z and radius of particle k (16-byte aligned)
   /// Size the array for n particles (no fill).
   void resize(std::size_t n) { xyzr.resize(4 * n); }
   /// Copy particles [first, last) of the store (the array sized by resize()).
   void fill(const ParticleStore& s, std::size_t first, std::size_t last);
-  const Pair* pairs() const { return reinterpret_cast<const Pair*>(xyzr.data()); }
   std::size_t bytes() const { return xyzr.capacity() * sizeof(double); }
 };
-static_assert(__STDCPP_DEFAULT_NEW_ALIGNMENT__ >= 16, "PackedPositions reads xyzr as aligned 16-byte pairs");
+static_assert(__STDCPP_DEFAULT_NEW_ALIGNMENT__ >= 16, "the pair screen reads PackedPositions rows as aligned 16-byte pairs");
 
 /// The inputs of the pair sweep of one force evaluation.
 struct PairSweep {
@@ -110,7 +106,7 @@ struct PairSweep {
   uint32_t n_materials;
   double dt;
   bool record;  ///< append each contact's force to ContactScratch::records
-  const PackedPositions::Pair* packed;  ///< the store's positions and radii, packed and filled
+  const double* packed;  ///< the store's positions and radii, packed and filled (PackedPositions::xyzr)
 };
 
 /// The pair contacts of list entries [first, last). Forces on particles in

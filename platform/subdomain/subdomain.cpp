@@ -535,7 +535,7 @@ void Subdomain::step_in_order() {
 PairSweep Subdomain::pair_sweep() const {
   return {&store_, const_cast<NeighborList*>(&nlist_), pipeline_.get(), class_pairs_.data(), class_rolling_.data(),
           pair_class_.data(), static_cast<uint32_t>(class_pairs_.size()), static_cast<uint32_t>(materials_.size()),
-          dt_, record_, packed_.pairs()};
+          dt_, record_, packed_.xyzr.data()};
 }
 
 WallSweep Subdomain::wall_sweep() {
