@@ -150,12 +150,6 @@ void group_by_key(uint32_t c, uint32_t n_keys, KeyOf&& key, std::vector<uint32_t
   for (uint32_t q = 0; q < c; ++q) slot_of[q] = count[slot_of[q]]++;
 }
 
-/// 1 when the spheres of two packed entries overlap: |x_i - x_j|^2 <
-/// (r_i + r_j)^2, the separation's squares summed x, y, then z (the same
-/// operations in the same order as on the store's arrays, so the same
-/// result bit for bit). With SSE2 (every x86-64) on 16-byte registers: the
-/// (x, y) difference and its squares in one register each, the horizontal
-/// sum and the radii's square by a lane copy.
 /// A contact of list entry e opened: it is no longer touching and its
 /// history ends. Rare, and out of line, so that the screen's loop keeps no
 /// history pointer of its own.
@@ -164,6 +158,12 @@ void group_by_key(uint32_t c, uint32_t n_keys, KeyOf&& key, std::vector<uint32_t
   for (uint32_t h = 0; h < stride; ++h) history[e * stride + h] = 0.0;
 }
 
+/// Whether the spheres of particles i and j (rows of PackedPositions::xyzr)
+/// overlap: |x_i - x_j|^2 < (r_i + r_j)^2, the separation's squares summed
+/// x, y, then z (the same operations in the same order as on the store's
+/// arrays, so the same result bit for bit). With SSE2 (every x86-64) on
+/// 16-byte registers: the (x, y) difference and its squares in one register
+/// each, the horizontal sum and the radii's square by a lane copy.
 template <bool kPeriodic>
 inline bool overlaps(const double* xyzr, std::size_t i, std::size_t j, const double* per, const double* inv_per) {
   const double* pi = xyzr + 4 * i;
@@ -242,7 +242,7 @@ void pair_range(const PairSweep& sw, std::size_t first, std::size_t last, Contac
     // branch here mispredicts often.
     // The positions come packed (PackedPositions): the same values and the
     // same operations, in the same order, as from the store's arrays.
-    // An entry adds at most one contact, so kBatch - c entries cannot
+    // An entry adds at most one contact, so kBatch - filled entries cannot
     // overfill the batch: the inner loop tests only its end.
     std::size_t filled = 0;  // a full-width count: it indexes entry[] with no extension
     while (e < last && filled < kBatch) {

@@ -84,7 +84,8 @@ struct PackedPositions {
   std::vector<double> xyzr;  ///< [4 k, 4 k + 4): x, y, z and radius of particle k (16-byte aligned)
   /// Size the array for n particles (no fill).
   void resize(std::size_t n) { xyzr.resize(4 * n); }
-  /// Copy particles [first, last) of the store (the array sized by resize()).
+  /// Copy particles [first, last) of the store (the array sized by resize());
+  /// kick_drift (integrator.cpp) writes the same rows as it drifts.
   void fill(const ParticleStore& s, std::size_t first, std::size_t last);
   std::size_t bytes() const { return xyzr.capacity() * sizeof(double); }
 };

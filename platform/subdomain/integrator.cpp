@@ -146,7 +146,8 @@ DriftCounts kick_drift(ParticleStore& s, std::size_t first, std::size_t last, co
          s.vy.data(), s.vz.data(), s.wx.data(), s.wy.data(), s.wz.data(), s.fx.data(), s.fy.data(), s.fz.data(),
          s.tx.data(), s.ty.data(), s.tz.data(), s.inv_mass.data(), s.inv_inertia.data(), s.mass.data(), ex, ey, ez,
          check ? how.check->x0() : nullptr, check ? how.check->y0() : nullptr, check ? how.check->z0() : nullptr,
-         s.radius.data(), how.pack, check ? how.check->rebuild_displacement2() : 0.0, check ? how.check->far_tier_displacement2() : 0.0, out);
+         s.radius.data(), how.pack, check ? how.check->rebuild_displacement2() : 0.0,
+         check ? how.check->far_tier_displacement2() : 0.0, out);
   return out;
 }
 
