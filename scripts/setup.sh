@@ -27,7 +27,9 @@ if ((${#missing[@]})); then
 fi
 
 echo "[setup] configuring and building in $BUILD_DIR (-j$JOBS)"
+build_start=$SECONDS
 # DOMEL_CMAKE_ARGS: further configure arguments (scripts/sanitize); the last -DCMAKE_BUILD_TYPE wins
 # shellcheck disable=SC2086
 cmake -S "$DOMEL_ROOT" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release ${DOMEL_CMAKE_ARGS:-} >/dev/null
 cmake --build "$BUILD_DIR" -j "$JOBS"
+echo "[setup] built in $((SECONDS - build_start)) s"

@@ -17,7 +17,8 @@
 //    dependence on dt; the dt/2 runs check that the S–D/DCT difference
 //    holds at both steps.
 //  - the S–D result does not depend on dt: it keeps decaying at either step.
-// Label "slow": four runs of 1.5 s simulated, ~6 min on one core.
+// CI (label long) runs the scenario's step, 1e-5 s: two runs of 1.5 s, about
+// 2 minutes on one core; scripts/validate the half step too (label validate).
 #include "support/fixture.hpp"
 
 #include <gtest/gtest.h>
@@ -63,28 +64,31 @@ Series run(const std::string& model, double step) {
   return out;
 }
 
-}  // namespace
-
-TEST(CollapseSdVsDct, SpringDashpotComesToRestConstantTorqueKeepsChattering) {
-  const Series sd = run("sd_critical_angle", 1e-5), dct = run("dct", 1e-5);
-  const Series sd_half = run("sd_critical_angle", 5e-6), dct_half = run("dct", 5e-6);
+/// The claims of the file comment at one time step (both print their medians).
+void expect_sd_decays_and_dct_stalls(double step) {
+  const Series sd = run("sd_critical_angle", step), dct = run("dct", step);
   const double sd_early = sd.mean_median(0.95, 1.05), sd_late = sd.mean_median(1.45, 1.5);
   const double dct_early = dct.mean_median(0.95, 1.05), dct_late = dct.mean_median(1.45, 1.5);
-  const double sd_half_early = sd_half.mean_median(0.95, 1.05), sd_half_late = sd_half.mean_median(1.45, 1.5);
-  const double dct_half_early = dct_half.mean_median(0.95, 1.05), dct_half_late = dct_half.mean_median(1.45, 1.5);
-  const double dct_floor = dct.mean_median(1.0, 1.5), dct_half_floor = dct_half.mean_median(1.0, 1.5);
-  std::printf("S-D  median |omega|: %.3g (t~1.0) -> %.3g (t~1.5); at dt/2 %.3g -> %.3g\n", sd_early, sd_late,
-              sd_half_early, sd_half_late);
-  std::printf("DCT  median |omega|: %.3g (t~1.0) -> %.3g (t~1.5); at dt/2 %.3g -> %.3g; window means %.3g, at dt/2 "
-              "%.3g\n", dct_early, dct_late, dct_half_early, dct_half_late, dct_floor, dct_half_floor);
+  const double dct_floor = dct.mean_median(1.0, 1.5);
+  std::printf("dt = %g s: S-D  median |omega| %.3g (t~1.0) -> %.3g (t~1.5)\n", step, sd_early, sd_late);
+  std::printf("dt = %g s: DCT  median |omega| %.3g (t~1.0) -> %.3g (t~1.5); window mean %.3g\n", step, dct_early,
+              dct_late, dct_floor);
   EXPECT_LT(sd_late, 0.1 * sd_early) << "S-D must keep decaying, at least tenfold over the last 0.5 s";
-  EXPECT_LT(sd_half_late, 0.1 * sd_half_early) << "S-D at dt/2";
   EXPECT_GT(dct_late, 0.3 * dct_early) << "DCT should stall";
-  EXPECT_GT(dct_half_late, 0.3 * dct_half_early) << "DCT at dt/2";
-  // S–D ends far below the level DCT stalls at, at either step
-  EXPECT_LT(sd_late, 0.01 * dct_floor);
-  EXPECT_LT(sd_half_late, 0.01 * dct_half_floor);
+  EXPECT_LT(sd_late, 0.01 * dct_floor) << "S-D ends far below the level DCT stalls at";
 }
+
+}  // namespace
+
+// CI size (label long): the scenario's time step, 1e-5 s.
+TEST(CollapseSdVsDct, SpringDashpotComesToRestConstantTorqueKeepsChattering) {
+  expect_sd_decays_and_dct_stalls(1e-5);
+}
+
+// Full size (label validate, scripts/validate): the same at half the time
+// step, so the difference is not a time-step artefact (two runs of 1.5 s at
+// 5e-6 s: about 4 minutes on one core).
+TEST(CollapseSdVsDctFullSize, TheDifferenceHoldsAtHalfTheTimeStep) { expect_sd_decays_and_dct_stalls(5e-6); }
 
 // Guards issue 3, acceptance 6(e): the angle-of-repose probe (free-surface fit
 // of the heap, platform/subdomain/repose_probe.cpp) shows that the S–D model
