@@ -6,7 +6,8 @@
 #include "io/atomic_file.hpp"
 #include "io/output_folder.hpp"
 #include "scenario/scenario.hpp"
-#include "scheduler/schedule.hpp"
+#include "loop/macro_step.hpp"
+#include "outputs/probes.hpp"
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>

@@ -8,7 +8,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "distributed/communicator.hpp"
-#include "distributed/run_ranks.hpp"
+#include "distributed/mpi_ranks.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output_folder.hpp"
 #include "loader/plugin_registry.hpp"

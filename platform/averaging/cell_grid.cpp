@@ -69,6 +69,7 @@ CellGrid::CellGrid(CellGridSpec spec) : spec_(std::move(spec)) {
   if (spec_.every < 1) {
     throw std::invalid_argument(where + "every must be at least 1, got " + std::to_string(spec_.every));
   }
+  samples_ = Cadence::in_ticks(static_cast<std::uint64_t>(spec_.every));
   if (!(spec_.write_interval >= 0)) {
     throw std::invalid_argument(where + "write_interval must be >= 0");
   }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/neighbor_list.hpp"
+#include "core/cadence.hpp"
 #include "core/particle_store.hpp"
 #include "geometry/wall.hpp"
 
@@ -143,7 +144,7 @@ class CellGrid {
   /// their image inside the periodic box.
   void set_periodic(const PeriodicBox& box) { periodic_ = box; }
   /// True on the steps the grid samples (step % every == 0).
-  bool due(std::uint64_t step) const { return step % static_cast<std::uint64_t>(spec_.every) == 0; }
+  bool due(std::uint64_t step) const { return samples_.on(step); }
 
   /// Accessible-volume weight w_c of each cell: the fraction of the cell on
   /// the particle side of every wall, by regular sub-sampling
@@ -212,6 +213,7 @@ class CellGrid {
   std::vector<double> accessible_;
   CellFields latest_;
   CellFields sum_;                 ///< running sums since the last take (velocity slots hold momentum)
+  Cadence samples_;       ///< every spec_.every steps of the subdomain, from step 0
   PeriodicBox periodic_;  ///< set_periodic()
   std::size_t pending_ = 0;
   std::vector<std::ptrdiff_t> cell_scratch_;  ///< cell of each particle in the current sample

@@ -10,7 +10,7 @@
 #include "core/error.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
-#include "scheduler/run_ranks.hpp"
+#include "loop/ranks.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -118,7 +118,7 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
   if (spec_.grid_interval > 0) {
     vtk_fine_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_fine");
     vtk_coarse_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_coarse");
-    grid_files_ = Interval(spec_.grid_interval, spec_.grid_interval, macro_step_of(subdomains));
+    grid_files_ = Cadence::in_time(spec_.grid_interval, spec_.grid_interval, macro_step_of(subdomains));
   }
 }
 
@@ -578,10 +578,10 @@ void Coupling::write_row(double t, const ParticleStore& s, const ParticleFlow& f
   balance_->append(row);
 }
 
-void Coupling::write_grids(double t, bool final) {
+void Coupling::write_grids(std::uint64_t tick, double t, bool final) {
   if (!vtk_fine_) return;
-  if (!final && !grid_files_.due(t)) return;
-  grid_files_.advance(t);
+  if (!final && !grid_files_.due(tick)) return;
+  grid_files_.advance(tick);
   if (fine_grid_->samples_pending() > 0) vtk_fine_->write(t, *fine_grid_, fine_grid_->mean_since_last_take());
   if (coarse_grid_->samples_pending() > 0)
     vtk_coarse_->write(t, *coarse_grid_, coarse_grid_->mean_since_last_take());

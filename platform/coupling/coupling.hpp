@@ -40,8 +40,8 @@
 #include "averaging/cell_grid.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
-#include "scheduler/particle_flow.hpp"
-#include "scheduler/schedule.hpp"
+#include "flow/particle_flow.hpp"
+#include "loop/macro_step.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <nlohmann/json.hpp>
@@ -164,8 +164,8 @@ class Coupling {
   /// on ranks.
   void exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains,
                 const std::vector<WallPrimitive>& walls, ParticleFlow& flow);
-  /// Grid files due at t (or the last ones when final).
-  void write_grids(double t, bool final);
+  /// Grid files due at macro step `tick`, time t (or the last ones when final).
+  void write_grids(std::uint64_t tick, double t, bool final);
   /// Checkpoints (docs/checkpoint.md), written at a macro-step start before
   /// the exchange: both grids' averages, every face's books and queue, the
   /// parcels followed and those already counted, the insertion RNG, the
@@ -231,7 +231,7 @@ class Coupling {
   double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
   std::unique_ptr<io::CsvSeries> balance_;
   std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;
-  Interval grid_files_;  ///< the grid files, every grid_interval (never due when 0)
+  Cadence grid_files_;  ///< the grid files, every grid_interval (never due when 0)
   // scratch of the controller views
   std::vector<std::uint32_t> cell_f_, cell_c_, count_f_, count_c_;
   std::vector<double> stress_f_, stress_c_;

@@ -9,7 +9,7 @@
 #include "core/error.hpp"
 #include "core/particle_store.hpp"
 #include "io/cell_grid_output.hpp"
-#include "scheduler/run_ranks.hpp"
+#include "loop/ranks.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <spdlog/spdlog.h>
@@ -202,10 +202,10 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
   }
 }
 
-void FluidCoupling::write_fields(double t, bool final, const std::filesystem::path& out) {
+void FluidCoupling::write_fields(std::uint64_t tick, double t, bool final, const std::filesystem::path& out) {
   if (spec_.write_interval <= 0) return;
-  if (!final && t + 1e-9 * spec_.interval < next_write_) return;
-  while (next_write_ <= t + 1e-9 * spec_.interval) next_write_ += spec_.write_interval;
+  if (!final && !fields_.due(tick)) return;
+  fields_.advance(tick);
   domel_fluid_fields_v1 f{};
   try {
     if (!spec_.model->fluid_fields(f)) return;
@@ -232,12 +232,12 @@ void FluidCoupling::write_fields(double t, bool final, const std::filesystem::pa
   fields_out_->write(t, image);
 }
 
-void FluidCoupling::save(ArchiveWriter& w, const std::string& p) const {
+void FluidCoupling::save(ArchiveWriter& w, const std::string& p) {
   const auto bytes = spec_.model->save_state();
   w.put_text(p + "coupler_state", std::string(bytes.begin(), bytes.end()));
   w.put(p + "counts", std::vector<std::uint64_t>{exchanges_, has_limits_ ? 1u : 0u, last_limits_.solver_iterations,
-                                                 spec_.levels.size()});
-  std::vector<double> reals = {seconds_, next_write_, last_limits_.max_interval, last_limits_.solver_residual};
+                                                 spec_.levels.size(), fields_.index()});
+  std::vector<double> reals = {seconds_, last_limits_.max_interval, last_limits_.solver_residual};
   for (const auto& f : net_force_) reals.insert(reals.end(), f.begin(), f.end());
   w.put(p + "reals", reals);
   w.put_text(p + "limit", last_limit_);
@@ -253,15 +253,16 @@ void FluidCoupling::load(const ArchiveReader& r, const std::string& p, const std
   }
   const auto n = r.get<std::uint64_t>(p + "counts");
   const auto v = r.get<double>(p + "reals");
-  if (n.size() != 4 || n[3] != spec_.levels.size() || v.size() != 4 + 3 * spec_.levels.size())
+  if (n.size() != 5 || n[3] != spec_.levels.size() || v.size() != 3 + 3 * spec_.levels.size())
     r.fail(p + "counts", "does not hold the state of a fluid shared by " + std::to_string(spec_.levels.size()) +
                              " level(s)");
   exchanges_ = n[0];
   has_limits_ = n[1] != 0;
   last_limits_.solver_iterations = static_cast<uint32_t>(n[2]);
-  seconds_ = v[0], next_write_ = v[1], last_limits_.max_interval = v[2], last_limits_.solver_residual = v[3];
+  fields_.resume(n[4]);
+  seconds_ = v[0], last_limits_.max_interval = v[1], last_limits_.solver_residual = v[2];
   for (std::size_t L = 0; L < net_force_.size(); ++L)
-    for (int d = 0; d < 3; ++d) net_force_[L][d] = v[4 + 3 * L + d];
+    for (int d = 0; d < 3; ++d) net_force_[L][d] = v[3 + 3 * L + d];
   last_limit_ = r.text(p + "limit");
   const auto times = r.get<double>(p + "field_times");
   if (!times.empty() && (!ranks_ || ranks_->rank() == 0)) {  // rank 0 writes the fields
@@ -288,6 +289,25 @@ nlohmann::json FluidCoupling::summary() const {
                    {"solver_residual", last_limits_.solver_residual}};
   if (fields_out_) j["fields"] = "fluid.pvd";
   return j;
+}
+
+void FluidCoupling::setup(RunContext& ctx) {
+  exchanges_due_ = Cadence::in_ticks(spec_.interval_macro);
+  fields_ = Cadence::in_time(spec_.write_interval, 0.0, ctx.macro);
+}
+
+void FluidCoupling::before_macro(RunContext& ctx, const MacroStep& step) {
+  if (exchanges_due_.on(step.index)) exchange(step.t, ctx.subdomains);
+}
+
+void FluidCoupling::output(RunContext& ctx, const MacroStep& step) {
+  if (!step.last) write_fields(step.index, step.t, false, ctx.out);
+}
+
+void FluidCoupling::finish(RunContext& ctx, nlohmann::json& out) {
+  write_fields(ctx.end_index, ctx.end_time, true, ctx.out);
+  out["fluid"] = summary();
+  if (out["fluid"].contains("fields")) out["outputs"]["fluid"] = "fluid.pvd";
 }
 
 }  // namespace domel::platform

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "loader/plugin_registry.hpp"
+#include "loop/component.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -54,7 +55,9 @@ struct FluidSpec {
   bool one_level_per_call = false;
 };
 
-class FluidCoupling {
+/// A run component: the exchange before the macro steps it is due at, the
+/// fields among the outputs, the summary at the end.
+class FluidCoupling final : public Component {
  public:
   /// Gives each level's particles the coupling's per-particle arrays and
   /// registers the post_force hook that applies the fluid force.
@@ -65,8 +68,15 @@ class FluidCoupling {
 
   const FluidSpec& spec() const { return spec_; }
 
-  /// Whether macro step `index` starts with an exchange.
-  bool due(std::uint64_t index) const { return index % spec_.interval_macro == 0; }
+  // Component
+  unsigned points() const override { return kBeforeMacro | kOutput; }
+  std::string section() const override { return "fluid/"; }
+  void init(RunContext& ctx) override { set_ranks(ctx.ranks); }
+  void setup(RunContext& ctx) override;
+  void before_macro(RunContext& ctx, const MacroStep& step) override;
+  void output(RunContext& ctx, const MacroStep& step) override;
+  void finish(RunContext& ctx, nlohmann::json& summary) override;
+  void load(RunContext& ctx, const ArchiveReader& r, const std::string& prefix) override { load(r, prefix, ctx.out); }
 
   /// One exchange at time t. Throws RuntimeError naming the block when the
   /// plugin fails, when its stable interval is shorter than the coupling
@@ -79,17 +89,17 @@ class FluidCoupling {
   /// drag. Null: one process.
   void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
 
-  /// Write the coupler's fields when due (or, `final`, at the end whatever
-  /// the interval) into <out>/fluid_<NNNNNN>.vti and fluid.pvd. Spread over
-  /// ranks, every rank calls it (the coupler is asked alike everywhere) and
-  /// rank 0 writes.
-  void write_fields(double t, bool final, const std::filesystem::path& out);
+  /// Write the coupler's fields when due at macro step `tick`, time t (or,
+  /// `final`, at the end whatever the interval) into
+  /// <out>/fluid_<NNNNNN>.vti and fluid.pvd. Spread over ranks, every rank
+  /// calls it (the coupler is asked alike everywhere) and rank 0 writes.
+  void write_fields(std::uint64_t tick, double t, bool final, const std::filesystem::path& out);
 
   /// Checkpoints (docs/checkpoint.md): the coupler's state (ABI 2.3
   /// save_state), the exchange count, the last limits, the fields' schedule
   /// and frames. The per-particle arrays (drag, held force, velocity
   /// integrals) are the particle store's and saved with it.
-  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void save(ArchiveWriter& w, const std::string& prefix) override;
   /// On a restart, before the first exchange; `out` is the run's folder.
   void load(const ArchiveReader& r, const std::string& prefix, const std::filesystem::path& out);
 
@@ -109,7 +119,8 @@ class FluidCoupling {
   std::vector<std::string> names_;  ///< per level: the subdomain's name
   std::uint64_t exchanges_ = 0;
   double seconds_ = 0;
-  double next_write_ = 0;
+  Cadence exchanges_due_;  ///< every interval_macro macro steps, from 0
+  Cadence fields_;         ///< the fields' files, every write_interval from 0
   bool has_limits_ = false;
   domel_fluid_limits_v1 last_limits_{};
   std::string last_limit_;  ///< last_limits_.limit's text

@@ -9,9 +9,18 @@
 // one is optional and tested with contains(). Every problem becomes a
 // Diagnostic; build() throws them all at once, before anything is written.
 #include "coupling/coupling.hpp"
+#include "coupling/level_couplings.hpp"
 #include "geometry/region.hpp"
 #include "geometry/triangle_mesh.hpp"  // MeshError
 #include "io/particle_state.hpp"
+#include "outputs/contact_frames.hpp"
+#include "outputs/grid_files.hpp"
+#include "outputs/output_kinds.hpp"
+#include "outputs/particle_frames.hpp"
+#include "outputs/probes.hpp"
+#include "outputs/region_mass.hpp"
+#include "outputs/repose_angle.hpp"
+#include "outputs/state_files.hpp"
 #include "subdomain/diagnostics.hpp"
 #include "scenario/scenario.hpp"
 #include "scenario/scenario_detail.hpp"
@@ -49,6 +58,14 @@ struct Build {
   /// the interactions (indices) that name their own rolling model, in the
   /// order of PairCoefficients::rolling_model
   std::vector<std::size_t> pair_rolling;
+  /// The output blocks as read, made components by register_components()
+  struct Outputs {
+    double vtk_interval = 0, probe_interval = 0, contact_interval = 0;
+    bool state = false, wall_surfaces = true;
+    std::array<double, 3> scene_lo{}, scene_hi{};  ///< where unbounded walls are drawn
+    std::vector<RegionMassProbe> region_mass;
+    std::vector<GridSetup> grids;
+  } out;
 };
 
 void build_materials(Build& b) {
@@ -743,7 +760,7 @@ void build_particle_flow(Build& b) {
           b.ck.add(idx("/output/region_mass", i) + "/material", "unknown material '" + m + "'", suggest(m, names));
         }
       }
-      for (const auto& other : b.sim.region_mass)
+      for (const auto& other : b.out.region_mass)
         if (other.name == rm.name)
           b.ck.add(idx("/output/region_mass", i) + "/name", "duplicate region_mass name '" + rm.name + "'");
       for (const auto& pl : flow.planes)
@@ -752,9 +769,8 @@ void build_particle_flow(Build& b) {
                    "region_mass name '" + rm.name + "' is also a mass_flow plane's: both would write " + rm.name +
                        ".mass_kg to probes.csv",
                    "rename one of them");
-      b.sim.region_mass.push_back(rm);
+      b.out.region_mass.push_back(rm);
     }
-  flow.register_hooks(b.sim.hooks);
 }
 
 /// The first rotation of scenario wall `wall`'s motion (null if it does not rotate).
@@ -829,7 +845,7 @@ void build_contact_outputs(Build& b) {
                                  "frames to follow)",
              "give output.contacts.interval");
   b.sim.contact_sample.configure(std::move(probes), out.contains("contacts"));
-  b.sim.wall_surfaces = out["wall_surfaces"].get<bool>();
+  b.out.wall_surfaces = out["wall_surfaces"].get<bool>();
 }
 
 /// The parent map of /couplings (fine -> coarse), read before the subdomains
@@ -1016,8 +1032,8 @@ void scene_bounds(Build& b) {
   for (int a = 0; a < 3; ++a) diag += (hi[a] - lo[a]) * (hi[a] - lo[a]);
   const double pad = diag > 0 ? 0.05 * std::sqrt(diag) : 0.5;
   for (int a = 0; a < 3; ++a) {
-    sim.scene_lo[a] = lo[a] - pad;
-    sim.scene_hi[a] = hi[a] + pad;
+    b.out.scene_lo[a] = lo[a] - pad;
+    b.out.scene_hi[a] = hi[a] + pad;
   }
 }
 
@@ -1299,7 +1315,7 @@ void build_grids(Build& b) {
   const json& gs = out["grids"];
   for (std::size_t g = 0; g < gs.size(); ++g) {
     const json& gj = gs[g];
-    Simulation::GridSetup setup;
+    GridSetup setup;
     setup.spec.name = gj["name"].get<std::string>();
     for (int a = 0; a < 3; ++a) {
       setup.spec.lo[a] = gj["min"][a].get<double>();
@@ -1346,7 +1362,7 @@ void build_grids(Build& b) {
     for (std::size_t h = 0; h < g; ++h)
       if (gs[h]["name"] == gj["name"])
         b.ck.add(idx("/output/grids", g) + "/name", "duplicate grid name '" + setup.spec.name + "'");
-    b.sim.grid_setups.push_back(setup);
+    b.out.grids.push_back(setup);
   }
 }
 
@@ -1503,15 +1519,73 @@ void build_outputs(Build& b) {
   }
   const json& out = b.doc["output"];
   sim.output_directory = out.contains("directory") ? out["directory"].get<std::string>() : sim.name + "_out";
-  sim.vtk_interval = out.contains("vtk_interval") ? out["vtk_interval"].get<double>() : sim.duration / 50.0;
-  sim.probe_interval = out.contains("probe_interval") ? out["probe_interval"].get<double>() : sim.duration / 500.0;
-  sim.write_state = out["state"].get<bool>();
+  b.out.vtk_interval = out.contains("vtk_interval") ? out["vtk_interval"].get<double>() : sim.duration / 50.0;
+  b.out.probe_interval = out.contains("probe_interval") ? out["probe_interval"].get<double>() : sim.duration / 500.0;
+  b.out.state = out["state"].get<bool>();
   if (out.contains("contacts"))
-    sim.contact_interval = out["contacts"].contains("interval") ? out["contacts"]["interval"].get<double>()
-                                                                : sim.vtk_interval;
+    b.out.contact_interval = out["contacts"].contains("interval") ? out["contacts"]["interval"].get<double>()
+                                                                  : b.out.vtk_interval;
   scene_bounds(b);
-  for (auto& g : sim.grid_setups)
+  for (auto& g : b.out.grids)
     if (g.spec.write_interval < 0) g.spec.write_interval = sim.duration / 20.0;
+}
+
+/// Every component of the run, in the order they act at each point of the
+/// loop (loop/component.hpp): the particle flow, probes.csv, the particle
+/// and wall frames, the contact frames, the output grids (and the accessible
+/// volumes of every grid), the couplings, the fluid, the contact sample, the
+/// servo walls, the state files and the registered output kinds. So before
+/// a macro step: pours and deletions, the couplings' exchange, the fluid's;
+/// at an output time: probes, frames, contacts, grid files, the couplings'
+/// and the fluid's files. probes.csv's columns follow the subdomains'
+/// statistics in the order repose angle, region masses, flow, wall loads,
+/// servos.
+void register_components(Build& b) {
+  Simulation& sim = b.sim;
+  sim.components.push_back(&sim.flow);
+  std::vector<ProbeSource*> sources;
+  if (sim.repose_probe) {
+    auto& repose = sim.add(std::make_unique<ReposeAngleOutput>(*sim.repose_probe));
+    std::vector<std::string> names;
+    for (const auto& sd : sim.subdomains) names.push_back(sd->name());
+    repose.set_subdomain_names(std::move(names));
+    sources.push_back(&repose);
+  }
+  if (!b.out.region_mass.empty())
+    sources.push_back(&sim.add(std::make_unique<RegionMassOutput>(std::move(b.out.region_mass))));
+  sources.push_back(&sim.flow);
+  sources.push_back(&sim.contact_sample);
+  sources.push_back(&sim.servos);
+  auto& probes = sim.add(std::make_unique<ProbesOutput>(b.out.probe_interval, std::move(sources)));
+  std::vector<std::string> materials;
+  for (const Material& m : sim.materials) materials.push_back(m.name);
+  sim.add(std::make_unique<ParticleFrames>(b.out.vtk_interval, materials, b.out.wall_surfaces, b.out.scene_lo,
+                                           b.out.scene_hi, &probes));
+  auto& contact_frames = sim.add(std::make_unique<ContactFrames>(
+      sim.contact_sample.wants_rows() ? b.out.contact_interval : 0.0, sim.contact_sample));
+  if (probes.enabled() && sim.contact_sample.has_probes()) sim.contact_sample.wanted_at(&probes.cadence());
+  sim.contact_sample.wanted_at(&contact_frames.cadence());
+  sim.add(std::make_unique<GridFiles>(std::move(b.out.grids)));
+  sim.add(std::make_unique<LevelCouplings>(sim.couplings, sim.control_macro, sim.flow));
+  if (sim.fluid) sim.components.push_back(sim.fluid.get());
+  sim.components.push_back(&sim.contact_sample);
+  sim.components.push_back(&sim.servos);
+  if (b.out.state) sim.add(std::make_unique<StateFiles>(materials));
+  // the registered output kinds whose block the scenario has (outputs/output_kinds.hpp)
+  const json& out = b.doc["output"];
+  for (const OutputKind& kind : output_kinds()) {
+    if (!out.contains(kind.key)) continue;
+    OutputSetting setting{out[kind.key], "/output/" + kind.key, {}, materials, sim.duration, sim.macro_step()};
+    for (const auto& sd : sim.subdomains) setting.subdomains.push_back(sd->name());
+    try {
+      sim.add(kind.make(setting));
+    } catch (const ConfigError& e) {  // the factory's diagnostics, named after the scenario file
+      std::vector<Diagnostic> diags = e.diagnostics();
+      for (auto& d : diags)
+        if (d.file.empty()) d.file = b.file.string();
+      throw ConfigError(diags);
+    }
+  }
 }
 
 /// subdomains[].rank_share: on every subdomain or on none.
@@ -1556,9 +1630,10 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);
   build_outputs(b);
   if (fluid) {
-    if (fluid->write_interval < 0) fluid->write_interval = sim->vtk_interval;
+    if (fluid->write_interval < 0) fluid->write_interval = b.out.vtk_interval;
     sim->fluid = std::make_unique<FluidCoupling>(std::move(*fluid), sim->subdomains);
   }
+  register_components(b);
   if (sim->checkpoint_interval > 0) {
     const std::string why = sim->why_no_checkpoint();
     if (!why.empty())

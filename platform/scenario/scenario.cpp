@@ -4,6 +4,8 @@
 // filled document by builders.cpp.
 #include "scenario/scenario.hpp"
 
+#include "outputs/output_kinds.hpp"
+
 #include "core/rotation.hpp"
 
 #include "geometry/region.hpp"
@@ -95,7 +97,12 @@ void check_periodic_axis(const json& doc, int a, double lo, double hi, const std
 }  // namespace
 
 const json& platform_scenario_schema() {
-  static const json schema = json::parse(kScenarioSchemaText);
+  // the registered output kinds' blocks join the output block (outputs/output_kinds.hpp)
+  static const json schema = [] {
+    json s = json::parse(kScenarioSchemaText);
+    for (const OutputKind& k : output_kinds()) s["$defs"]["output"]["properties"][k.key] = k.schema;
+    return s;
+  }();
   return schema;
 }
 

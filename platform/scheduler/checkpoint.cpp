@@ -5,10 +5,10 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "loader/plugin_registry.hpp"
-#include "coupling/coupling.hpp"
-#include "fluid/fluid_coupling.hpp"
-#include "scheduler/run_ranks.hpp"
-#include "scheduler/simulation.hpp"
+#include "flow/particle_flow.hpp"
+#include "loop/ranks.hpp"
+#include "scheduler/servo.hpp"
+#include "subdomain/subdomain.hpp"
 
 #include <ctime>
 
@@ -54,25 +54,9 @@ int major_of(const std::string& version) {
   }
 }
 
-/// The models that keep their own state in the checkpoint (ABI 2.3): each
-/// coupling's controllers and the fluid coupler, "where" -> {model, version, library}.
-nlohmann::json stateful_models(const Simulation& sim) {
-  nlohmann::json j = nlohmann::json::object();
-  auto entry = [](const ModelInstance& m) {
-    return nlohmann::json{{"model", m.model().name}, {"version", m.model().version}, {"library", m.model().library_name}};
-  };
-  for (const auto& c : sim.couplings) {
-    if (c->spec().stress.enabled) j["coupling '" + c->spec().name + "', stress_control"] = entry(*c->spec().stress.model);
-    if (c->spec().velocity.enabled)
-      j["coupling '" + c->spec().name + "', velocity_control"] = entry(*c->spec().velocity.model);
-  }
-  if (sim.fluid) j["fluid"] = entry(*sim.fluid->spec().model);
-  return j;
-}
-
 }  // namespace
 
-void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
+void write_checkpoint(const std::filesystem::path& file, CheckpointWorld& sim, const LoopState& loop,
                       const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra,
                       RunRanks* ranks) {
   // spread over ranks: every rank's part of each subdomain, on rank 0
@@ -114,7 +98,7 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
   }
   header["subdomains"] = sds;
   header["models"] = sim.models_used;
-  header["stateful_models"] = stateful_models(sim);
+  header["stateful_models"] = sim.stateful_models;
   nlohmann::json libs = nlohmann::json::array();
   for (const auto& lib : registry.libraries())
     libs.push_back({{"name", lib.name}, {"version", lib.version},
@@ -122,11 +106,10 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
   header["plugin_libraries"] = libs;
   header["document"] = sim.document;
 
-  w.put(std::string("loop/counters"), std::vector<std::uint64_t>{loop.macro_index, loop.probe_rows, loop.vtk_frames,
-                                                                  loop.checkpoints, loop.probe_bytes,
+  w.put(std::string("loop/counters"), std::vector<std::uint64_t>{loop.macro_index, loop.checkpoints,
                                                                   static_cast<std::uint64_t>(loop.threads)});
-  w.put(std::string("loop/reals"), std::vector<double>{loop.time, loop.probe_period, loop.vtk_period});
-  w.put(std::string("loop/vtk_times"), loop.vtk_times);
+  w.put(std::string("loop/reals"), std::vector<double>{loop.time});
+  if (!sim.servos.empty()) sim.servos.save(w, "servos/");
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
     if (!ranks) {
       sim.subdomains[k]->save(w, sd_prefix(k));
@@ -141,7 +124,7 @@ void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const 
   io::write_file_atomically(file, w.serialize(header.dump()));
 }
 
-OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simulation& sim) {
+OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const CheckpointWorld& sim) {
   OpenedCheckpoint ck;
   ck.archive = std::make_unique<ArchiveReader>(file);
   const ArchiveReader& r = *ck.archive;
@@ -196,7 +179,7 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
   // The controllers and the fluid coupler: their saved state is their own
   // format, so another major version is refused too.
   const nlohmann::json was_stateful = ck.header.value("stateful_models", nlohmann::json::object());
-  const nlohmann::json now_stateful = stateful_models(sim);
+  const nlohmann::json& now_stateful = sim.stateful_models;
   for (const auto& [where, m] : now_stateful.items()) {
     if (!was_stateful.contains(where)) continue;  // a scenario change, reported above
     const std::string old_v = was_stateful[where].value("version", std::string()), new_v = m.value("version", std::string());
@@ -213,17 +196,11 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
 
   const auto c = r.get<std::uint64_t>("loop/counters");
   const auto reals = r.get<double>("loop/reals");
-  if (c.size() != 6 || reals.size() != 3) r.fail("loop/counters", "does not hold the run loop's state");
+  if (c.size() != 3 || reals.size() != 1) r.fail("loop/counters", "does not hold the run loop's state");
   ck.loop.macro_index = c[0];
-  ck.loop.probe_rows = c[1];
-  ck.loop.vtk_frames = c[2];
-  ck.loop.checkpoints = c[3];
-  ck.loop.probe_bytes = c[4];
-  ck.loop.threads = static_cast<int>(c[5]);
+  ck.loop.checkpoints = c[1];
+  ck.loop.threads = static_cast<int>(c[2]);
   ck.loop.time = reals[0];
-  ck.loop.probe_period = reals[1];
-  ck.loop.vtk_period = reals[2];
-  ck.loop.vtk_times = r.get<double>("loop/vtk_times");
   // "ranks" since checkpoints under MPI; earlier files were written by one process
   const nlohmann::json ranks = ck.header.contains("ranks") ? ck.header["ranks"] : nlohmann::json(std::uint64_t{1});
   if (!ranks.is_number_integer() || ranks.get<std::int64_t>() < 1 || ranks.get<std::int64_t>() > (1 << 24))
@@ -232,7 +209,7 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
   return ck;
 }
 
-bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim, RunRanks* ranks) {
+bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRanks* ranks) {
   bool same_split = true;
   const ArchiveReader& r = *ck.archive;
   // the servos' travel first: the subdomains place their walls with it

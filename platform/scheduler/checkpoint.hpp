@@ -19,37 +19,51 @@
 
 namespace domel::platform {
 
-class Simulation;
 class PluginRegistry;
 class RunRanks;
+class Subdomain;
+class WallServos;
+class ParticleFlow;
 
 /// The checkpoint file's name in the output folder.
 inline constexpr const char* kCheckpointFile = "checkpoint.ckpt";
 
-/// The run loop's state at the start of macro step `macro_index`, before
-/// its hooks and outputs.
+/// The run loop's own state at the start of macro step `macro_index`,
+/// before its components act; each component keeps its own (its section).
 struct LoopState {
   std::uint64_t macro_index = 0;
-  double time = 0;                   ///< [s] macro_index x macro step
-  std::uint64_t probe_rows = 0;      ///< Interval indices (schedule.hpp)
-  std::uint64_t vtk_frames = 0;
-  std::uint64_t checkpoints = 0;
-  double probe_period = 0, vtk_period = 0;  ///< the periods those indices count
-  std::uint64_t probe_bytes = 0;     ///< probes.csv's length after its last flush
-  std::vector<double> vtk_times;     ///< frames of particles.pvd
+  double time = 0;               ///< [s] macro_index x macro step
+  std::uint64_t checkpoints = 0;  ///< the checkpoints' cadence index (core/cadence.hpp)
   int threads = 1;
   int ranks = 1;  ///< the processes the run was spread over (header "ranks")
 };
 
-/// Write `file` atomically: the header, the loop state, every subdomain and
-/// the particle flow. Finishes every subdomain's pending step first.
-/// `extra` adds the sections of what the run loop owns (cell grids and their files).
+/// What a checkpoint holds of a run besides its components' sections (the
+/// world: servo walls, subdomains, the particle flow's books), and what a
+/// restart's scenario is compared with (Simulation::world()).
+struct CheckpointWorld {
+  const std::string& name;
+  const std::filesystem::path& scenario_file;
+  const nlohmann::json& document;     ///< the validated scenario, defaults filled
+  const nlohmann::json& models_used;  ///< per subdomain: slot -> {model, version, library}
+  /// "where" -> {model, version, library} of the models that save their own
+  /// state (each coupling's controllers, the fluid coupler)
+  nlohmann::json stateful_models;
+  std::vector<std::unique_ptr<Subdomain>>& subdomains;
+  WallServos& servos;
+  ParticleFlow& flow;
+};
+
+/// Write `file` atomically: the header, the loop state and the world (the
+/// servo walls' travel, every subdomain, the particle flow's books).
+/// Finishes every subdomain's pending step first. `extra` adds the
+/// components' sections (Simulation::run).
 ///
 /// Spread over ranks (`ranks`), every rank calls it: each subdomain is
 /// written as one part per rank (that rank's own particles, ghosts, lists
 /// and exchange), gathered to rank 0, which writes the file; what every rank
-/// holds alike (the loop, the flow, `extra`) is rank 0's.
-void write_checkpoint(const std::filesystem::path& file, Simulation& sim, const LoopState& loop,
+/// holds alike (the loop, the servos, the flow, `extra`) is rank 0's.
+void write_checkpoint(const std::filesystem::path& file, CheckpointWorld& sim, const LoopState& loop,
                       const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra = {},
                       RunRanks* ranks = nullptr);
 
@@ -67,7 +81,7 @@ struct OpenedCheckpoint {
 /// model or plugin major version, coarse-grain ratio, time step, walls,
 /// pours ...). Changes of the end time, output intervals, threads, output
 /// folder and checkpoint interval are allowed and listed.
-OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simulation& sim);
+OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const CheckpointWorld& sim);
 
 /// Restore every subdomain and the particle flow from an opened checkpoint
 /// (instead of Subdomain::setup() and ParticleFlow::start()). Returns false
@@ -75,6 +89,6 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Simula
 /// count): the run then differs from the uninterrupted one by round-off.
 /// Spread over ranks, every rank restores its own part of each subdomain
 /// (a checkpoint of the same rank count: the run goes on bit for bit).
-bool restore_checkpoint(const OpenedCheckpoint& ck, Simulation& sim, RunRanks* ranks = nullptr);
+bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRanks* ranks = nullptr);
 
 }  // namespace domel::platform

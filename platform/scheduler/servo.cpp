@@ -2,7 +2,7 @@
 #include "scheduler/servo.hpp"
 
 #include "core/archive.hpp"
-#include "scheduler/run_ranks.hpp"
+#include "loop/ranks.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <algorithm>
@@ -47,7 +47,7 @@ void WallServos::append_values(double t, std::vector<double>& row) const {
   }
 }
 
-void WallServos::save(ArchiveWriter& w, const std::string& prefix) const {
+void WallServos::save(ArchiveWriter& w, const std::string& prefix) {
   std::vector<double> v;
   for (const WallServo& s : servos)
     v.insert(v.end(), {s.state->s_ref, s.state->t_ref, s.state->velocity, s.measured});

@@ -14,6 +14,7 @@
 #pragma once
 
 #include "geometry/wall_motion.hpp"
+#include "loop/component.hpp"
 
 #include <cstddef>
 #include <limits>
@@ -39,9 +40,20 @@ struct WallServo {
   double measured = std::numeric_limits<double>::quiet_NaN();  ///< [N] F at the last update
 };
 
-class WallServos {
+/// A run component: update() after every macro step, the servos' columns in
+/// probes.csv. Their travel is part of the world a checkpoint holds (save
+/// and load, called by scheduler/checkpoint.cpp before the subdomains,
+/// which place their walls with it), not a component section.
+class WallServos final : public Component, public ProbeSource {
  public:
   std::vector<WallServo> servos;
+
+  unsigned points() const override { return servos.empty() ? 0u : kAfterMacro; }
+  void after_macro(RunContext& ctx, const MacroStep& step) override { update(step.t, ctx.subdomains, ctx.ranks); }
+  void probe_columns(std::vector<std::string>& names) const override {
+    for (const auto& c : columns()) names.push_back(c);
+  }
+  void probe_values(RunContext&, double t, std::vector<double>& row) override { append_values(t, row); }
 
   bool empty() const { return servos.empty(); }
   /// After a macro step ending at t: measure and set the velocities. Spread
@@ -51,7 +63,7 @@ class WallServos {
   std::vector<std::string> columns() const;
   void append_values(double t, std::vector<double>& row) const;
 
-  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void save(ArchiveWriter& w, const std::string& prefix) override;
   void load(const ArchiveReader& r, const std::string& prefix);
 };
 

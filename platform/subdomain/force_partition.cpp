@@ -2,6 +2,8 @@
 // The threads' split of a force evaluation (force_partition.hpp).
 #include "subdomain/force_partition.hpp"
 
+#include "core/cadence.hpp"
+
 #include "core/archive.hpp"
 #include <algorithm>
 #include <iterator>
@@ -169,12 +171,12 @@ void ForcePartition::balance(const NeighborList& list, bool far_active, const st
   // unless the threads' estimated costs in the last force evaluation (their
   // ranges' entries, and their contacts as counted there) differ by more
   // than kRebalanceAt.
-  constexpr std::uint64_t kBalanceEvery = 32;
+  static const Cadence kBalanceEvery = Cadence::in_ticks(32);
   constexpr double kRebalanceAt = 0.01;
   const int nt = threads();
   const std::size_t tiers[3] = {0, list.near_size(), list.size()};
   if (split_[0].size() == static_cast<std::size_t>(nt) + 1 && split_builds_ == list.builds()) {
-    if (step % kBalanceEvery != 0) return;
+    if (!kBalanceEvery.on(step)) return;
     double lo = 0, hi = 0;
     for (std::size_t q = 0; q < static_cast<std::size_t>(nt); ++q) {
       std::size_t entries = split_[0][q + 1] - split_[0][q];

@@ -15,6 +15,7 @@
 // The volume fraction: the grid's sum of phi V_c w_c is the particles'
 // volume exactly (every centre lies in the grid; binning by centre moves
 // volume between cells, never out of the grid).
+#include "outputs/grid_files.hpp"
 #include "support/fixture.hpp"
 
 #include <gtest/gtest.h>
@@ -54,7 +55,7 @@ TEST(CellStress, SettledColumnStressBalancesItsWeight) {
     top = std::max(top, s.z[k]);
   }
   ASSERT_LT(top, 0.09) << "the column must fit the grid for the exact balance";
-  const auto& grid = *sim->grids[0];
+  const auto& grid = *sim->find<domel::platform::GridFiles>()->grids()[0];
   const auto& f = grid.latest();
   double virial_zz = 0, phi_volume = 0;
   for (std::size_t c = 0; c < grid.cell_count(); ++c) {

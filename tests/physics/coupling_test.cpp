@@ -300,13 +300,18 @@ TEST(Coupling, ExchangesHappenWhenAllLevelsStandAtTheSameTime) {
   EXPECT_DOUBLE_EQ(spec.stress.params["kp"].get<double>(), 1.0 / 16);
   EXPECT_NEAR(spec.stress.params["ki"].get<double>(), 1.0 / (16 * 1.8e-5), 1e-9);
   EXPECT_DOUBLE_EQ(spec.velocity.params["kp"].get<double>(), 1.0 / 8);
-  // What each level's clock says at every exchange (a before-hook runs just before the coupling's).
+  // What each level's clock says at every exchange (a component registered
+  // last acts just after the couplings, before the levels step).
   std::vector<std::array<double, 4>> seen;  // t, t_fine, t_coarse, fine steps
-  sim->hooks.before.push_back([&](const dp::MacroStep& m) {
-    if (m.index == 0 || m.index % 8 != 0) return;
-    auto& sds = *m.subdomains;
-    seen.push_back({m.t, sds[1]->time(), sds[0]->time(), static_cast<double>(sds[1]->steps())});
-  });
+  std::uint64_t calls_seen = 0;
+  sim->add(std::make_unique<dp::HookComponent>(
+      [&](const dp::MacroStep& m) {
+        if (sim->couplings[0]->control_calls() == calls_seen) return;  // no exchange at this macro step
+        calls_seen = sim->couplings[0]->control_calls();
+        auto& sds = *m.subdomains;
+        seen.push_back({m.t, sds[1]->time(), sds[0]->time(), static_cast<double>(sds[1]->steps())});
+      },
+      nullptr));
   dp::RunOptions opt;
   opt.output_directory = std::filesystem::temp_directory_path() / ("domel_coupling_test_" + std::to_string(::getpid()));
   opt.progress = false;
@@ -319,6 +324,7 @@ TEST(Coupling, ExchangesHappenWhenAllLevelsStandAtTheSameTime) {
     EXPECT_NEAR(seen[k][1], seen[k][0], 1e-12) << "fine level not at the exchange time";
     EXPECT_NEAR(seen[k][2], seen[k][0], 1e-12) << "coarse level not at the exchange time";
     EXPECT_EQ(seen[k][3], 16.0 * (k + 1));
+    EXPECT_NEAR(seen[k][0], 8.0 * (k + 1) * 3.6e-5, 1e-12) << "an exchange off the control clock";
   }
   EXPECT_NEAR(sim->couplings[0]->last_exchange_time(), 40 * 3.6e-5, 1e-12);
   // and the cell averages the controllers read were sampled at that time (Coupling::control checks it)

@@ -110,7 +110,7 @@ Bed run_bed(const json& doc, double t_from) {
   bed.lo = 1e300, bed.hi = -1e300;
   const auto every = static_cast<std::uint64_t>(std::llround(5e-3 / sim->macro_step()));
   dp::Simulation* raw = sim.get();
-  sim->hooks.after.push_back([&](const dp::MacroStep& step) {
+  sim->add(std::make_unique<dp::HookComponent>(nullptr, [&](const dp::MacroStep& step) {
     if ((step.index + 1) % every != 0 || step.t < t_from) return;
     const double d = pressure_drop(*raw);
     double z = 0;
@@ -118,7 +118,7 @@ Bed run_bed(const json& doc, double t_from) {
     bed.dp += d, bed.height += 2 * z / store.size();
     bed.lo = std::min(bed.lo, d), bed.hi = std::max(bed.hi, d);
     ++bed.samples;
-  });
+  }));
   dp::RunOptions o;
   o.output_directory = std::filesystem::temp_directory_path() / ("domel_fbed_" + std::to_string(getpid()));
   o.progress = false;

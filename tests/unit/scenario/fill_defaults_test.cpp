@@ -4,6 +4,8 @@
 // allOf, the matching oneOf branch) and only where a key is absent; a default
 // omitted from a scenario reaches the built Simulation as the schema states
 // it; and the builders read no key with a second, in-code fallback.
+#include "outputs/grid_files.hpp"
+#include "outputs/state_files.hpp"
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -96,7 +98,9 @@ TEST(FillDefaults, ASchemaDefaultReachesTheBuiltSimulation) {
   EXPECT_EQ(sim->models_used["sd"]["normal"]["model"], slots["normal"]["default"]["model"]);
   EXPECT_EQ(sim->models_used["sd"]["tangential"]["model"], slots["tangential"]["default"]["model"]);
   EXPECT_FALSE(sim->models_used["sd"].contains("rolling"));  // default "none"
-  EXPECT_EQ(sim->write_state, defs["output"]["properties"]["state"]["default"].get<bool>());
+  // output.state's default (false): no state files' component
+  EXPECT_FALSE(defs["output"]["properties"]["state"]["default"].get<bool>());
+  EXPECT_EQ(sim->find<domel::platform::StateFiles>(), nullptr);
   EXPECT_EQ(sim->threads, 0);  // run.threads has no default: DOMEL_THREADS, else 1, at run time
   const auto& store = sim->subdomains[0]->store();
   ASSERT_EQ(store.size(), 8u);
@@ -111,8 +115,10 @@ TEST(FillDefaults, ACellGridWithoutWriteIntervalGetsTheDocumentedDefault) {
   json doc = json::parse(in);
   for (auto& g : doc["output"]["grids"]) g.erase("write_interval");
   auto sim = domel::test::build(doc);
-  ASSERT_EQ(sim->grid_setups.size(), 2u);
-  for (const auto& g : sim->grid_setups) EXPECT_DOUBLE_EQ(g.spec.write_interval, sim->duration / 20.0);
+  const auto* grids = sim->find<domel::platform::GridFiles>();
+  ASSERT_NE(grids, nullptr);
+  ASSERT_EQ(grids->setups().size(), 2u);
+  for (const auto& g : grids->setups()) EXPECT_DOUBLE_EQ(g.spec.write_interval, sim->duration / 20.0);
 }
 
 // Every integer key of the composed schema (platform and built-in plugins)

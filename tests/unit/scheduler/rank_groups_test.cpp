@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
-// The levels' rank groups (subdomains[].rank_share, scheduler/run_ranks.hpp):
+// The levels' rank groups (subdomains[].rank_share, loop/ranks.hpp):
 // consecutive groups that cover the ranks, sized in proportion to the shares
 // by largest remainders, at least one rank each.
-#include "scheduler/run_ranks.hpp"
+#include "loop/ranks.hpp"
 
 #include <gtest/gtest.h>
 

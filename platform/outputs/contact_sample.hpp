@@ -6,14 +6,19 @@
 // output time (Subdomain::set_record_contacts) and hands them to take(); the
 // outputs written at that time read the sample. A sample belongs to one
 // time; asked for another, the wall loads are NaN and no contact frame is
-// written.
+// written. As a run component it decides before every macro step's steps
+// whether an output at its end reads the sample (the cadences it was given
+// by wanted_at()), has each subdomain record its last step's contacts then,
+// and takes them; its wall-load columns go to probes.csv.
 #pragma once
 
 #include "averaging/cell_grid.hpp"
+#include "core/archive.hpp"
 #include "core/particle_store.hpp"
 #include "geometry/wall.hpp"
 #include "io/contact_writer.hpp"
-#include "scheduler/particle_flow.hpp"
+#include "flow/particle_flow.hpp"
+#include "loop/component.hpp"
 
 #include <cstddef>
 #include <limits>
@@ -23,8 +28,6 @@
 namespace domel::platform {
 
 class Subdomain;
-class ArchiveWriter;
-class ArchiveReader;
 
 /// output.wall_loads[k]: the load the particles put on one scenario wall.
 struct WallLoadProbe {
@@ -36,7 +39,7 @@ struct WallLoadProbe {
   double axis[3] = {0, 0, 1};              ///< its unit direction
 };
 
-class ContactSample {
+class ContactSample final : public Component, public ProbeSource {
  public:
   void configure(std::vector<WallLoadProbe> probes, bool rows);
   bool enabled() const { return !probes_.empty() || rows_wanted_; }
@@ -56,7 +59,7 @@ class ContactSample {
   void take(std::size_t k, const Subdomain& sd, const std::vector<WallPrimitive>& walls);
   /// The same from particles `s` and their contact records (a subdomain
   /// spread over ranks: every rank's particles and records, gathered;
-  /// scheduler/gathered_contacts.hpp); sd gives the material pairs.
+  /// outputs/gathered_contacts.hpp); sd gives the material pairs.
   void take(std::size_t k, const Subdomain& sd, const ParticleStore& s,
             const std::vector<const std::vector<ContactRecord>*>& records, const std::vector<WallPrimitive>& walls);
 
@@ -68,10 +71,35 @@ class ContactSample {
 
   /// Checkpoints: the sample held for the next outputs (taken at the end of
   /// the macro step before the checkpoint, written after it).
-  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void save(ArchiveWriter& w, const std::string& prefix) override;
   void load(const ArchiveReader& r, const std::string& prefix);
 
+  // Component
+  /// An output whose due ticks (macro steps) read the sample: the probes'
+  /// rows (when there are wall-load probes) and the contact frames.
+  void wanted_at(const Cadence* outputs) { wanted_at_.push_back(outputs); }
+  unsigned points() const override { return enabled() ? kBeforeSteps | kStep : 0u; }
+  std::string section() const override { return enabled() ? "contacts/" : ""; }
+  /// A fresh run: every subdomain records its first force evaluation's contacts...
+  void init(RunContext& ctx) override;
+  /// ...which are the sample of t = 0.
+  void setup(RunContext& ctx) override;
+  void before_steps(RunContext& ctx, const MacroStep& step) override;
+  bool records_contacts(std::size_t, bool last) const override { return sampling_ && last; }
+  void after_step(RunContext& ctx, std::size_t k, bool last) override;
+  void load(RunContext&, const ArchiveReader& r, const std::string& prefix) override {
+    if (r.has(prefix + "time")) load(r, prefix);  // absent when the checkpointed run had no sample
+  }
+  void probe_columns(std::vector<std::string>& names) const override;
+  void probe_values(RunContext& ctx, double t, std::vector<double>& row) override;
+
  private:
+  /// Subdomain k's contacts of its last step, on ranks from every rank's
+  /// particles and records (gathered on every rank: a servo moves its wall
+  /// alike on all).
+  void take(RunContext& ctx, std::size_t k);
+  std::vector<const Cadence*> wanted_at_;
+  bool sampling_ = false;  ///< this macro step's last steps record for the sample
   std::vector<WallLoadProbe> probes_;
   bool rows_wanted_ = false;
   double time_ = std::numeric_limits<double>::quiet_NaN();

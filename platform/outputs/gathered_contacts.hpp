@@ -8,7 +8,7 @@
 
 #include "averaging/cell_grid.hpp"
 #include "core/particle_store.hpp"
-#include "scheduler/run_ranks.hpp"
+#include "loop/ranks.hpp"
 
 #include <vector>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Pours, deletion regions, mass-flow planes and the exact mass balance
 // (particle_flow.hpp says why they run between steps and in batches).
-#include "scheduler/particle_flow.hpp"
+#include "flow/particle_flow.hpp"
 
 #include "core/archive.hpp"
 #include "core/error.hpp"
@@ -136,31 +136,47 @@ void ParticleFlow::start(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
   for (auto& pl : planes) pl.side.assign(subdomains.size(), {});
   check_planes(subdomains);
   const double macro = macro_step_of(subdomains);
-  checks_ = Interval(deletions.empty() ? 0.0 : deletion_interval, deletion_interval, macro);
-  for (auto& p : pours) p.schedule = Interval(p.interval, p.start, macro);
+  checks_ = Cadence::in_time(deletions.empty() ? 0.0 : deletion_interval, deletion_interval, macro);
+  for (auto& p : pours) p.schedule = Cadence::in_time(p.interval, p.start, macro);
 }
 
-void ParticleFlow::update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains) {
+void ParticleFlow::update(const MacroStep& step, std::vector<std::unique_ptr<Subdomain>>& subdomains) {
   if (ranks_) {
     // the ghosts' contact counts go home before any rank edits its particles
     // (an edit drops the ghosts; the outputs' gathers later in this macro
     // step then find the counts collected). Collective, so on every rank.
     for (auto& sd : subdomains) sd->collect_contact_counts();
   }
-  if (checks_.take(t)) {
+  const double t = step.t;
+  if (checks_.take(step.index)) {
     check_planes(subdomains);  // count crossings before the crossed particles are deleted
     delete_particles(subdomains);
   }
   for (auto& p : pours) {
-    if (!p.schedule.due(t) || t >= p.end || p.inserted_mass >= p.total_mass) continue;
+    if (!p.schedule.due(step.index) || t >= p.end || p.inserted_mass >= p.total_mass) continue;
     pour(p, t, *subdomains[p.subdomain]);
-    p.schedule.advance(t);
+    p.schedule.advance(step.index);
   }
 }
 
-void ParticleFlow::register_hooks(MacroHooks& hooks) {
+void ParticleFlow::setup(RunContext& ctx) {
+  if (!ctx.restart) start(ctx.subdomains);  // a restart's restore() started it
+}
+
+void ParticleFlow::finish(RunContext& ctx, nlohmann::json& out) {
   if (empty()) return;
-  hooks.before.push_back([this](const MacroStep& step) { update(step.t, *step.subdomains); });
+  check_planes(ctx.subdomains);
+  const nlohmann::json books = summary(ctx.subdomains);
+  for (auto& [key, value] : books.items()) out[key] = value;
+}
+
+void ParticleFlow::probe_columns(std::vector<std::string>& names) const {
+  for (const auto& c : columns()) names.push_back(c);
+}
+
+void ParticleFlow::probe_values(RunContext& ctx, double t, std::vector<double>& row) {
+  check_planes(ctx.subdomains);
+  append_row(t, row);
 }
 
 void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
@@ -433,7 +449,7 @@ void get_series(const ArchiveReader& r, const std::string& p, FlowSeries& s) {
 
 }  // namespace
 
-void ParticleFlow::save(ArchiveWriter& w, const std::string& p) const {
+void ParticleFlow::save(ArchiveWriter& w, const std::string& p) {
   w.put_scalar<std::uint64_t>(p + "next_id", next_id);
   std::vector<MassUnits> units;
   std::vector<std::uint64_t> counts;

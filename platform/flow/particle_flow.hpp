@@ -17,8 +17,9 @@
 #pragma once
 
 #include "loader/plugin_registry.hpp"
-#include "scheduler/run_ranks.hpp"
-#include "scheduler/schedule.hpp"
+#include "loop/macro_step.hpp"
+#include "loop/component.hpp"
+#include "loop/ranks.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <nlohmann/json.hpp>
@@ -108,7 +109,7 @@ struct Pour {
   double interval = 0;      ///< [s] between insertion events
   std::uint64_t seed = 0;
   // state
-  Interval schedule;         ///< events due at start + k interval (set by ParticleFlow::start)
+  Cadence schedule;          ///< events due at start + k interval (set by ParticleFlow::start)
   std::uint64_t events = 0;
   std::uint64_t inserted = 0;
   double inserted_mass = 0;  ///< [kg]
@@ -141,7 +142,11 @@ struct MassFlowPlane {
   FlowSeries series;
 };
 
-class ParticleFlow {
+/// A run component (loop/component.hpp): pours and checks before every
+/// macro step, plane rates and books in probes.csv and summary.json. Its
+/// books are part of the world a checkpoint holds with the subdomains
+/// (save/restore, called by scheduler/checkpoint.cpp), not a component section.
+class ParticleFlow final : public Component, public ProbeSource {
  public:
   std::vector<Pour> pours;
   std::vector<DeletionRegion> deletions;
@@ -170,16 +175,26 @@ class ParticleFlow {
   void expect_external() { external_ = true; }
 
   /// Before the first step: every particle present counts as inserted; the
-  /// pours' and checks' intervals start (their tolerance from the
-  /// subdomains' macro step, schedule.hpp).
+  /// pours' and checks' cadences start (their tolerance from the subdomains'
+  /// macro step, loop/cadence.hpp).
   void start(std::vector<std::unique_ptr<Subdomain>>& subdomains);
-  /// At simulated time t (the start of a macro step): pours and checks that are due.
-  void update(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains);
-  /// Register update() as a before-macro-step hook (once, when not empty()).
-  /// The hook points at this object, which must outlive the hooks.
-  void register_hooks(MacroHooks& hooks);
+  /// At the start of macro step `step.index` (time step.t): pours and checks that are due.
+  void update(const MacroStep& step, std::vector<std::unique_ptr<Subdomain>>& subdomains);
   /// Plane crossings up to now (also called at every probe row and at the end).
   void check_planes(std::vector<std::unique_ptr<Subdomain>>& subdomains);
+
+  // Component: the ranks before the levels' set-up (a restart's restore()
+  // counts over them), the start of a fresh run at setup, update() before
+  // every macro step
+  unsigned points() const override { return empty() ? 0u : kBeforeMacro; }
+  void init(RunContext& ctx) override { set_ranks(ctx.ranks); }
+  void setup(RunContext& ctx) override;
+  void before_macro(RunContext& ctx, const MacroStep& step) override { update(step, ctx.subdomains); }
+  /// The plane crossings to the end, and summary.json's books (when not empty()).
+  void finish(RunContext& ctx, nlohmann::json& summary) override;
+  // ProbeSource: columns() and append_row(), the planes checked first
+  void probe_columns(std::vector<std::string>& names) const override;
+  void probe_values(RunContext& ctx, double t, std::vector<double>& row) override;
 
   std::vector<std::string> columns() const;
   /// Append this row's values (cumulative masses and rates since the last row).
@@ -194,7 +209,7 @@ class ParticleFlow {
   /// sides, the checks' schedule. restore() replaces start() in a restarted
   /// run and throws ConfigError when the scenario's pours, deletion regions
   /// or planes are not the checkpoint's.
-  void save(ArchiveWriter& w, const std::string& prefix) const;
+  void save(ArchiveWriter& w, const std::string& prefix) override;
   void restore(const ArchiveReader& r, const std::string& prefix, std::vector<std::unique_ptr<Subdomain>>& subdomains);
 
  private:
@@ -209,7 +224,7 @@ class ParticleFlow {
   RunRanks* ranks_ = nullptr;
   std::vector<MassAccount> accounts_;
   bool external_ = false;
-  Interval checks_;  ///< deletion (and plane) checks, every deletion_interval from deletion_interval on
+  Cadence checks_;  ///< deletion (and plane) checks, every deletion_interval from deletion_interval on
   double last_row_t_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> last_row_;
 };

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // What a run spread over several processes (issue 19) asks of the layer
-// that spreads it (distributed/run_ranks.hpp): every rank builds the same
+// that spreads it (distributed/mpi_ranks.hpp): every rank builds the same
 // scenario, keeps its share of each subdomain's particles and steps it;
 // rank 0 alone writes the outputs, from the particles gathered to it in id
 // order and from statistics summed over the ranks. Simulation::run() takes
@@ -82,6 +82,12 @@ class RunRanks {
   virtual std::vector<std::vector<char>> gather_to_root(const std::vector<char>& mine) = 0;
   /// Element-wise sums over the ranks, in place. Collective.
   virtual void sum(std::vector<std::uint64_t>& v) = 0;
+  /// One count summed over the ranks. Collective.
+  std::uint64_t sum_count(std::uint64_t x) {
+    std::vector<std::uint64_t> v{x};
+    sum(v);
+    return v[0];
+  }
   /// Element-wise sums over the ranks, added up in rank order, so the same
   /// bits on every rank and run to run for a given rank count. Collective.
   std::vector<double> sum_in_rank_order(const std::vector<double>& mine) {

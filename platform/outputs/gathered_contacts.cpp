@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "scheduler/gathered_contacts.hpp"
+#include "outputs/gathered_contacts.hpp"
 
 #include "core/error.hpp"
 #include "subdomain/subdomain.hpp"

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Wall loads and contact rows from the recorded contact forces.
-#include "scheduler/contact_sample.hpp"
+#include "outputs/contact_sample.hpp"
 
 #include "core/archive.hpp"
+#include "loop/ranks.hpp"
+#include "outputs/gathered_contacts.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <cmath>
@@ -104,7 +106,7 @@ const std::vector<io::ContactRow>* ContactSample::rows_at(double t, double toler
   return rows_wanted_ && std::fabs(t - time_) <= tolerance ? &rows_ : nullptr;
 }
 
-void ContactSample::save(ArchiveWriter& w, const std::string& prefix) const {
+void ContactSample::save(ArchiveWriter& w, const std::string& prefix) {
   w.put_scalar(prefix + "time", time_);
   w.put(prefix + "sums", sums_);
   w.put_text(prefix + "rows",
@@ -122,6 +124,47 @@ void ContactSample::load(const ArchiveReader& r, const std::string& prefix) {
   if (bytes.size() % sizeof(io::ContactRow) != 0) r.fail(prefix + "rows", "is not a whole number of contact rows");
   rows_.resize(bytes.size() / sizeof(io::ContactRow));
   if (!bytes.empty()) std::memcpy(rows_.data(), bytes.data(), bytes.size());
+}
+
+void ContactSample::init(RunContext& ctx) {
+  if (!ctx.restart && enabled())
+    for (auto& sd : ctx.subdomains) sd->set_record_contacts(true);  // the outputs at t = 0 (wall loads, contacts)
+}
+
+void ContactSample::setup(RunContext& ctx) {
+  if (ctx.restart || !enabled()) return;
+  begin(0.0);
+  for (std::size_t k = 0; k < ctx.subdomains.size(); ++k) {
+    take(ctx, k);
+    ctx.subdomains[k]->set_record_contacts(false);
+  }
+}
+
+void ContactSample::before_steps(RunContext& ctx, const MacroStep& step) {
+  // the contacts of the macro step's last steps, when an output at its end reads them
+  sampling_ = false;
+  for (const Cadence* c : wanted_at_) sampling_ = sampling_ || c->due(step.index + 1);
+  if (sampling_) begin(static_cast<double>(step.index + 1) * ctx.macro);
+}
+
+void ContactSample::after_step(RunContext& ctx, std::size_t k, bool last) {
+  if (sampling_ && last) take(ctx, k);
+}
+
+void ContactSample::take(RunContext& ctx, std::size_t k) {
+  Subdomain& sd = *ctx.subdomains[k];
+  if (!ctx.ranks) return take(k, sd, ctx.walls);
+  const ParticleStore all = ctx.ranks->gather(sd, true);
+  const std::vector<ContactRecord> records = gather_contact_records(*ctx.ranks, sd, all);
+  take(k, sd, all, {&records}, ctx.walls);
+}
+
+void ContactSample::probe_columns(std::vector<std::string>& names) const {
+  for (const auto& c : columns()) names.push_back(c);
+}
+
+void ContactSample::probe_values(RunContext& ctx, double t, std::vector<double>& row) {
+  append_values(t, kTimeTolerance * ctx.macro, row);
 }
 
 }  // namespace domel::platform

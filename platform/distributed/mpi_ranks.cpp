@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "distributed/run_ranks.hpp"
+#include "distributed/mpi_ranks.hpp"
 
 #include "distributed/particle_exchange.hpp"
 #include "distributed/subdomain_ranks.hpp"

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
-// The RunRanks of a run under mpirun (scheduler/run_ranks.hpp): the ranks of
+// The RunRanks of a run under mpirun (loop/ranks.hpp): the ranks of
 // MPI_COMM_WORLD, each subdomain spread by distribute() (subdomain_ranks.hpp).
 #pragma once
 
 #include "distributed/communicator.hpp"
 #include "distributed/subdomain_ranks.hpp"
-#include "scheduler/run_ranks.hpp"
+#include "loop/ranks.hpp"
 
 #include <utility>
 #include <vector>

@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Particle and wall frames (particle_frames.hpp).
+#include "outputs/particle_frames.hpp"
+
+#include "core/archive.hpp"
+#include "outputs/probes.hpp"
+#include "subdomain/subdomain.hpp"
+
+namespace domel::platform {
+
+void ParticleFrames::setup(RunContext& ctx) {
+  frames_ = Cadence::in_time(interval_, 0.0, ctx.macro);
+  if (interval_ <= 0 || !ctx.writer) return;
+  vtk_ = std::make_unique<io::VtkSeriesWriter>(ctx.out, "particles");
+  vtk_->set_material_names(materials_);
+  if (wall_surfaces_ && !ctx.walls.empty()) walls_ = std::make_unique<io::WallSurfaceSeries>(ctx.out, "walls");
+}
+
+void ParticleFrames::output(RunContext& ctx, const MacroStep& step) {
+  if (!frames_.take(step.index)) return;
+  const double t = step.t;
+  std::vector<io::ParticleSet> sets;  // gathered on every rank: collective
+  for (std::size_t k = 0; k < ctx.subdomains.size(); ++k)
+    sets.push_back({&ctx.particles(k, t), static_cast<int>(k), &ctx.subdomains[k]->materials()});
+  if (!vtk_) return;
+  vtk_->write(t, sets);
+  if (walls_) walls_->write(t, ctx.walls, lo_.data(), hi_.data());
+  if (probes_) probes_->flush();  // probes.csv reaches the frame just written
+}
+
+void ParticleFrames::finish(RunContext&, nlohmann::json& summary) {
+  summary["outputs"]["particles"] = interval_ > 0 ? "particles.pvd" : "";
+  summary["outputs"]["walls"] = walls_ ? "walls.pvd" : "";
+}
+
+void ParticleFrames::save(ArchiveWriter& w, const std::string& p) {
+  w.put_scalar<std::uint64_t>(p + "index", frames_.index());
+  w.put_scalar(p + "period", frames_.period());
+  w.put(p + "times", vtk_ ? vtk_->frame_times() : std::vector<double>{});
+  w.put(p + "wall_times", walls_ ? walls_->frame_times() : std::vector<double>{});
+}
+
+void ParticleFrames::load(RunContext& ctx, const ArchiveReader& r, const std::string& p) {
+  frames_.restore(r.scalar<std::uint64_t>(p + "index"), r.scalar<double>(p + "period"), ctx.first);
+  if (vtk_) vtk_->resume(r.get<double>(p + "times"));
+  if (walls_) walls_->resume(r.get<double>(p + "wall_times"));
+}
+
+}  // namespace domel::platform
