@@ -2,6 +2,10 @@
 // Coupling: removal at the region's faces, face counting of coarse parcels,
 // transfer by sequential simple inhibition (docs/physics.md §5.5, §6.2), the
 // controller views (§5.3, §5.4) and the interface balance.
+// About 770 lines in one file: the steps of an exchange work in order on the
+// same gathered levels, face books and queues (coupling.hpp), whose exact
+// books (counted = inserted + pending) hold only across all of them;
+// read top to bottom the file is the exchange as physics.md §5-§6 gives it.
 #include "coupling/coupling.hpp"
 
 #include "core/abi_views.hpp"
