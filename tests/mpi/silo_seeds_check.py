@@ -37,7 +37,7 @@ DURATION: run.duration [s], default the scenario's):
   balance file are the same bytes (reproducible for a given rank count;
   tests/mpi/run_cli_test.py checks it on 2, 3 and 4 ranks for another case).
 
-CI (label long) runs one seed of a shortened silo (the fill and the first
+CI (label long) runs one seed of a shortened silo (0.65 s: the fill and the first
 discharge: books, pours, groups and reproducibility); scripts/validate
 (label validate) the three seeds of the whole run and the discharge.
 """
