@@ -51,7 +51,9 @@ def main(argv):
         labels = labels_of(build_dir)
         per = {}
         for name, _, sec in TEST_LINE.findall(text):
-            for lab in labels.get(name, ["(none)"]):
+            # a parameterised test's ctest name goes on after a space ("  # GetParam() = ...")
+            labs = labels.get(name) or next((v for k, v in labels.items() if k.startswith(name + " ")), ["(none)"])
+            for lab in labs:
                 n, s, longest = per.get(lab, (0, 0.0, ("", 0.0)))
                 per[lab] = (n + 1, s + float(sec), max(longest, (name, float(sec)), key=lambda x: x[1]))
         rows.append((step, wall, int(built[-1]) if built else None, per))

@@ -398,38 +398,36 @@ LayerProfile CellGrid::profile(const CellFields& f, int axis) const {
   return p;
 }
 
-void CellGrid::save(ArchiveWriter& w, const std::string& p) const {
-  w.put(p + "accessible", accessible_);
-  // (no structured bindings: the lambdas capture the prefix, which C++17 does not allow of a binding)
-  for (const auto& set : {std::pair<const char*, const CellFields*>{"latest/", &latest_}, {"sum/", &sum_}}) {
-    const std::string at = p + set.first;
-    const CellFields* fields = set.second;
-    const_cast<CellFields*>(fields)->for_each_field(
-        [&](const char* name, const std::vector<double>& v) { w.put(at + name, v); });
-    w.put(at + "time_samples", std::vector<double>{fields->time, static_cast<double>(fields->samples)});
+void CellGrid::fields(CheckpointFields& f) {
+  f("accessible", accessible_);
+  if (f.loading() && accessible_.size() != n_cells_)
+    f.reader().fail(f.prefix() + "accessible", "holds a grid of " + std::to_string(accessible_.size()) +
+                                                   " cells; cell grid '" + spec_.name + "' has " +
+                                                   std::to_string(n_cells_));
+  for (const auto& set : {std::pair<const char*, CellFields*>{"latest/", &latest_}, {"sum/", &sum_}}) {
+    const std::string at = set.first;
+    CellFields* cells = set.second;
+    cells->for_each_field([&](const char* name, std::vector<double>& v) {
+      f(at + name, v);
+      if (f.loading() && !v.empty() && v.size() != n_cells_ && v.size() != 9 * n_cells_)
+        f.reader().fail(f.prefix() + at + name, "does not hold one value (or nine) per cell");
+    });
+    std::uint64_t samples = cells->samples;
+    f(at + "time", cells->time);
+    f(at + "samples", samples);
+    cells->samples = static_cast<std::size_t>(samples);
   }
-  w.put_scalar<std::uint64_t>(p + "pending", pending_);
+  std::uint64_t pending = pending_;
+  f("pending", pending);
+  pending_ = static_cast<std::size_t>(pending);
+}
+
+void CellGrid::save(ArchiveWriter& w, const std::string& p) const {
+  save_fields(w, p, [&](CheckpointFields& f) { const_cast<CellGrid*>(this)->fields(f); });
 }
 
 void CellGrid::load(const ArchiveReader& r, const std::string& p) {
-  r.get_into(p + "accessible", accessible_);
-  if (accessible_.size() != n_cells_)
-    r.fail(p + "accessible", "holds a grid of " + std::to_string(accessible_.size()) + " cells; cell grid '" +
-                                 spec_.name + "' has " + std::to_string(n_cells_));
-  for (const auto& set : {std::pair<const char*, CellFields*>{"latest/", &latest_}, {"sum/", &sum_}}) {
-    const std::string at = p + set.first;
-    CellFields* fields = set.second;
-    fields->for_each_field([&](const char* name, std::vector<double>& v) {
-      r.get_into(at + name, v);
-      if (!v.empty() && v.size() != n_cells_ && v.size() != 9 * n_cells_)
-        r.fail(at + name, "does not hold one value (or nine) per cell");
-    });
-    const auto ts = r.get<double>(at + "time_samples");
-    if (ts.size() != 2) r.fail(at + "time_samples", "does not hold a time and a sample count");
-    fields->time = ts[0];
-    fields->samples = static_cast<std::size_t>(ts[1]);
-  }
-  pending_ = r.scalar<std::uint64_t>(p + "pending");
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 }  // namespace domel::platform

@@ -32,6 +32,7 @@ inline constexpr std::size_t kMaxGridCells = 10000000;
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 /// One contact force, recorded during a force evaluation on sampling steps.
 /// A pair appears once (either orientation); i and j index the same
@@ -203,6 +204,8 @@ class CellGrid {
   /// checkpoint's grid has another cell count.
   void save(ArchiveWriter& w, const std::string& prefix) const;
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load, field by field (core/archive.hpp).
+  void fields(CheckpointFields& f);
 
  private:
   CellGridSpec spec_;

@@ -170,4 +170,41 @@ const ArchiveReader::Section& ArchiveReader::find(const std::string& key, Archiv
   return it->second;
 }
 
+CheckpointFields::CheckpointFields(const ArchiveReader& r, std::string prefix) : r_(&r), prefix_(std::move(prefix)) {
+  const std::string key = prefix_ + ".fields";
+  if (!r.has(key)) r.fail(key, "is missing: the checkpoint was written without the list of this part's fields");
+  std::istringstream in(r.text(key));
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) stored_.push_back(line);
+}
+
+void CheckpointFields::field(const std::string& key, ArchiveType type, bool scalar) {
+  const std::string entry = key + " " + type_name(type) + (scalar ? "" : "[]");
+  if (r_) {
+    const std::size_t k = listed_.size();
+    if (k >= stored_.size())
+      r_->fail(prefix_ + ".fields", "lists " + std::to_string(stored_.size()) + " fields; this build reads '" +
+                                        entry + "' as field " + std::to_string(k + 1) +
+                                        " (the checkpoint was written by another version of this part)");
+    if (stored_[k] != entry)
+      r_->fail(prefix_ + ".fields", "lists '" + stored_[k] + "' as field " + std::to_string(k + 1) +
+                                        " where this build reads '" + entry +
+                                        "' (the checkpoint was written by another version of this part)");
+  }
+  listed_.push_back(entry);
+}
+
+void CheckpointFields::finish() {
+  if (w_) {
+    std::string text;
+    for (const auto& e : listed_) text += e + "\n";
+    w_->put_text(prefix_ + ".fields", text);
+    return;
+  }
+  if (stored_.size() > listed_.size())
+    r_->fail(prefix_ + ".fields", "lists '" + stored_[listed_.size()] + "' as field " +
+                                      std::to_string(listed_.size() + 1) + ", which this build does not read "
+                                      "(the checkpoint was written by another version of this part)");
+}
+
 }  // namespace domel::platform

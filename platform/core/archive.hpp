@@ -23,11 +23,13 @@
 #include <map>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace domel::platform {
 
-inline constexpr std::uint32_t kArchiveVersion = 1;
+/// 2: every class's sections come with the list of its fields (CheckpointFields).
+inline constexpr std::uint32_t kArchiveVersion = 2;
 
 enum class ArchiveType : std::uint8_t { f64 = 1, u64 = 2, u32 = 3, u8 = 4, i64 = 5, bytes = 6 };
 
@@ -119,5 +121,81 @@ class ArchiveReader {
   std::string header_;
   std::map<std::string, Section> sections_;
 };
+
+/// One list of a class's checkpoint fields for both directions. A class
+/// describes its state once, in one function that names each field,
+///
+///   void Mine::fields(CheckpointFields& f) { f("counts", counts_); f("time", time_); ... }
+///
+/// which save() calls with a writing CheckpointFields and load() with a
+/// reading one, so that the two directions cannot drift apart. The writer
+/// also stores the list itself, each field's key and element type in order,
+/// under "<prefix>.fields"; the reader compares every field it is asked for
+/// with the list before it reads the value, and finish() checks that none is
+/// left over, so a checkpoint written by another version of the class (a
+/// field added, dropped, renamed or moved) is refused naming the field,
+/// whatever the values would have been. Scalars are arithmetic types or
+/// bool; arrays std::vector of the archive's element types; text a string.
+class CheckpointFields {
+ public:
+  CheckpointFields(ArchiveWriter& w, std::string prefix) : w_(&w), prefix_(std::move(prefix)) {}
+  CheckpointFields(const ArchiveReader& r, std::string prefix);
+  CheckpointFields(const CheckpointFields&) = delete;
+  CheckpointFields& operator=(const CheckpointFields&) = delete;
+
+  bool loading() const { return r_ != nullptr; }
+  const std::string& prefix() const { return prefix_; }
+  /// The archive read (loading() only), for a refusal naming its file.
+  const ArchiveReader& reader() const { return *r_; }
+
+  template <class T>
+  void operator()(const std::string& key, std::vector<T>& v) {
+    field(key, archive_type_of<T>(), false);
+    if (w_) w_->put(prefix_ + key, v);
+    else r_->get_into(prefix_ + key, v);
+  }
+  void operator()(const std::string& key, bool& b) {
+    std::uint8_t u = b ? 1 : 0;
+    (*this)(key, u);
+    b = u != 0;
+  }
+  template <class T, class = std::enable_if_t<std::is_arithmetic_v<T>>>
+  void operator()(const std::string& key, T& x) {
+    field(key, archive_type_of<T>(), true);
+    if (w_) w_->put_scalar(prefix_ + key, x);
+    else x = r_->scalar<T>(prefix_ + key);
+  }
+  void operator()(const std::string& key, std::string& text) {
+    field(key, ArchiveType::bytes, true);  // listed as "bytes": one text
+    if (w_) w_->put_text(prefix_ + key, text);
+    else text = r_->text(prefix_ + key);
+  }
+  /// The end of the list: the writer stores it, the reader refuses fields
+  /// the checkpoint has beyond the ones read.
+  void finish();
+
+ private:
+  void field(const std::string& key, ArchiveType type, bool scalar);
+  ArchiveWriter* w_ = nullptr;
+  const ArchiveReader* r_ = nullptr;
+  std::string prefix_;
+  std::vector<std::string> listed_;  ///< "key type", written or read so far
+  std::vector<std::string> stored_;  ///< the checkpoint's list (loading)
+};
+
+/// A class's fields saved, or loaded and checked, through `describe` (a
+/// callable taking CheckpointFields&), with the list finished.
+template <class Describe>
+void save_fields(ArchiveWriter& w, const std::string& prefix, Describe&& describe) {
+  CheckpointFields f(w, prefix);
+  describe(f);
+  f.finish();
+}
+template <class Describe>
+void load_fields(const ArchiveReader& r, const std::string& prefix, Describe&& describe) {
+  CheckpointFields f(r, prefix);
+  describe(f);
+  f.finish();
+}
 
 }  // namespace domel::platform

@@ -513,45 +513,47 @@ std::vector<double> periodic_record(const PeriodicBox& b) {
 }
 }  // namespace
 
-void NeighborList::save(ArchiveWriter& w, const std::string& p) const {
-  w.put(p + "i", i);
-  w.put(p + "j", j);
-  w.put(p + "history", history);
-  w.put(p + "touching", touching);
-  w.put(p + "x0", x0_);
-  w.put(p + "y0", y0_);
-  w.put(p + "z0", z0_);
-  w.put(p + "built_ids", built_ids_);
-  w.put(p + "counters", std::vector<std::uint64_t>{builds_, built_size_, built_version_, near_size_, stride_});
-  w.put_scalar(p + "skin", skin_);
-  w.put(p + "periodic", periodic_record(box_));
-}
-
-void NeighborList::load(const ArchiveReader& r, const std::string& p) {
-  r.get_into(p + "i", i);
-  r.get_into(p + "j", j);
-  r.get_into(p + "history", history);
-  r.get_into(p + "touching", touching);
-  r.get_into(p + "x0", x0_);
-  r.get_into(p + "y0", y0_);
-  r.get_into(p + "z0", z0_);
-  r.get_into(p + "built_ids", built_ids_);
-  const auto c = r.get<std::uint64_t>(p + "counters");
-  if (c.size() != 5) r.fail(p + "counters", "holds " + std::to_string(c.size()) + " values, expected 5");
-  if (c[4] != stride_)
-    r.fail(p + "counters", "holds contact histories of " + std::to_string(c[4]) +
-                               " values per pair; this scenario's contact model keeps " + std::to_string(stride_));
-  if (r.scalar<double>(p + "skin") != skin_) r.fail(p + "skin", "was written with another neighbour-list skin");
-  const std::vector<double> written = r.has(p + "periodic") ? r.get<double>(p + "periodic") : periodic_record({});
-  if (written != periodic_record(box_))
+void NeighborList::fields(CheckpointFields& f) {
+  f("i", i);
+  f("j", j);
+  f("history", history);
+  f("touching", touching);
+  f("x0", x0_);
+  f("y0", y0_);
+  f("z0", z0_);
+  f("built_ids", built_ids_);
+  std::uint64_t built_size = built_size_, near_size = near_size_, stride = stride_;
+  f("builds", builds_);
+  f("built_size", built_size);
+  f("built_version", built_version_);
+  f("near_size", near_size);
+  f("stride", stride);
+  double skin = skin_;
+  f("skin", skin);
+  std::vector<double> periodic = periodic_record(box_);
+  f("periodic", periodic);
+  if (!f.loading()) return;
+  const ArchiveReader& r = f.reader();
+  const std::string& p = f.prefix();
+  if (stride != stride_)
+    r.fail(p + "stride", "holds contact histories of " + std::to_string(stride) +
+                             " values per pair; this scenario's contact model keeps " + std::to_string(stride_));
+  if (skin != skin_) r.fail(p + "skin", "was written with another neighbour-list skin");
+  if (periodic != periodic_record(box_))
     r.fail(p + "periodic", "was written with other periodic boundaries (subdomains[].periodic)");
-  builds_ = c[0];
-  built_size_ = c[1];
-  built_version_ = c[2];
-  near_size_ = c[3];
+  built_size_ = static_cast<std::size_t>(built_size);
+  near_size_ = static_cast<std::size_t>(near_size);
   if (j.size() != i.size() || touching.size() != i.size() || history.size() != i.size() * stride_ ||
       near_size_ > i.size())
     r.fail(p + "i", "holds a neighbour list whose arrays disagree in length");
+}
+
+void NeighborList::save(ArchiveWriter& w, const std::string& p) const {
+  save_fields(w, p, [&](CheckpointFields& f) { const_cast<NeighborList*>(this)->fields(f); });
+}
+
+void NeighborList::load(const ArchiveReader& r, const std::string& p) {
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 }  // namespace domel::platform

@@ -58,6 +58,7 @@ inline double min_image(double d, double L, double inv_L) { return d - L * std::
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 /// Live contact histories keyed by their pairs' ids, as they leave one list
 /// (NeighborList::live_histories) and enter the next build of another
@@ -132,6 +133,8 @@ class NeighborList {
   /// that a restarted run goes on with the same list (checkpoints).
   void save(ArchiveWriter& w, const std::string& prefix) const;
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load, field by field (core/archive.hpp).
+  void fields(CheckpointFields& f);
 
   std::vector<uint32_t> i, j;      ///< particle indices, id[i] < id[j]
   std::vector<double> history;     ///< size() * stride

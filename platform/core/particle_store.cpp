@@ -105,48 +105,41 @@ const std::pair<const char*, std::vector<double> ParticleStore::*> kRealArrays[]
     {"inv_inertia", &ParticleStore::inv_inertia}};
 }  // namespace
 
-void ParticleStore::save(ArchiveWriter& w, const std::string& p) const {
-  w.put(p + "id", id);
-  for (const auto& [name, member] : kRealArrays) w.put(p + name, this->*member);
-  w.put(p + "contacts", contacts);
-  w.put(p + "flags", flags);
-  w.put(p + "material", material);
-  w.put_scalar<std::uint8_t>(p + "external_force", external_force_ ? 1 : 0);
+void ParticleStore::fields(CheckpointFields& f) {
+  f("id", id);
+  for (const auto& [name, member] : kRealArrays) f(name, this->*member);
+  f("contacts", contacts);
+  f("flags", flags);
+  f("material", material);
+  f("external_force", external_force_);
   if (external_force_) {
-    w.put(p + "ext_fx", ext_fx);
-    w.put(p + "ext_fy", ext_fy);
-    w.put(p + "ext_fz", ext_fz);
-  }
-  w.put_scalar<std::uint64_t>(p + "aux_count", aux.size());
-  for (std::size_t a = 0; a < aux.size(); ++a) w.put(p + "aux" + std::to_string(a), aux[a]);
-  w.put_scalar<std::uint64_t>(p + "layout_version", layout_version);
-}
-
-void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
-  r.get_into(p + "id", id);
-  for (const auto& [name, member] : kRealArrays) r.get_into(p + name, this->*member);
-  r.get_into(p + "contacts", contacts);
-  r.get_into(p + "flags", flags);
-  if (r.has(p + "material")) r.get_into(p + "material", material);
-  else material.assign(id.size(), 0);  // a checkpoint from before materials per particle: one material
-  external_force_ = r.scalar<std::uint8_t>(p + "external_force") != 0;
-  if (external_force_) {
-    r.get_into(p + "ext_fx", ext_fx);
-    r.get_into(p + "ext_fy", ext_fy);
-    r.get_into(p + "ext_fz", ext_fz);
+    f("ext_fx", ext_fx);
+    f("ext_fy", ext_fy);
+    f("ext_fz", ext_fz);
   } else {
-    ext_fx.clear(); ext_fy.clear(); ext_fz.clear();
+    ext_fx.clear(), ext_fy.clear(), ext_fz.clear();
   }
-  const auto n_aux = r.scalar<std::uint64_t>(p + "aux_count");
-  if (n_aux != aux.size())
-    r.fail(p + "aux_count", "holds " + std::to_string(n_aux) + " extra per-particle arrays; this scenario uses " +
-                                std::to_string(aux.size()));
-  for (std::size_t a = 0; a < aux.size(); ++a) r.get_into(p + "aux" + std::to_string(a), aux[a]);
-  layout_version = r.scalar<std::uint64_t>(p + "layout_version");
+  std::uint64_t n_aux = aux.size();
+  f("aux_count", n_aux);
+  if (f.loading() && n_aux != aux.size())
+    f.reader().fail(f.prefix() + "aux_count", "holds " + std::to_string(n_aux) +
+                                                  " extra per-particle arrays; this scenario uses " +
+                                                  std::to_string(aux.size()));
+  for (std::size_t a = 0; a < aux.size(); ++a) f("aux" + std::to_string(a), aux[a]);
+  f("layout_version", layout_version);
+  if (!f.loading()) return;
   const std::size_t n = id.size();
   bool same = true;
   for_each_array([&](const auto& v) { same = same && v.size() == n; });
-  if (!same) r.fail(p + "id", "has per-particle arrays of different lengths");
+  if (!same) f.reader().fail(f.prefix() + "id", "has per-particle arrays of different lengths");
+}
+
+void ParticleStore::save(ArchiveWriter& w, const std::string& p) const {
+  save_fields(w, p, [&](CheckpointFields& f) { const_cast<ParticleStore*>(this)->fields(f); });
+}
+
+void ParticleStore::load(const ArchiveReader& r, const std::string& p) {
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 namespace {

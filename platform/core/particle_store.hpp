@@ -13,6 +13,7 @@ namespace domel::platform {
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 struct ParticleStore {
   std::vector<std::uint64_t> id;           ///< unique within the run, stable
@@ -134,6 +135,8 @@ struct ParticleStore {
   /// The inverse of save(); throws ConfigError when a section is missing or
   /// the arrays' lengths disagree.
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load, field by field (core/archive.hpp).
+  void fields(CheckpointFields& f);
 
   /// Bytes held by the arrays (their capacity).
   std::size_t bytes() const {

@@ -593,120 +593,142 @@ void Coupling::write_grids(std::uint64_t tick, double t, bool final) {
 
 // ---- checkpoints ----------------------------------------------------------
 
-void Coupling::save(ArchiveWriter& w, const std::string& p) {
-  fine_grid_->save(w, p + "fine_grid/");
-  coarse_grid_->save(w, p + "coarse_grid/");
+void Coupling::fields(CheckpointFields& f) {
+  const bool load = f.loading();
+  const std::string& p = f.prefix();
   std::vector<MassUnits> units;
   std::vector<std::uint64_t> counts;
   std::vector<double> reals;
-  for (int face = 0; face < kFaces; ++face) {
-    const FaceBalance& fb = faces_[face];
-    units.insert(units.end(), {fb.counted, fb.inserted, fb.removed});
-    counts.insert(counts.end(), {fb.parcels, fb.n_inserted, fb.n_removed, fb.backlog,
-                                 static_cast<std::uint64_t>(fb.growing), fb.warned ? 1u : 0u, fb.warned_fill ? 1u : 0u});
-    reals.insert(reals.end(), {fb.fraction, fb.mass_open, fb.momentum[0], fb.momentum[1], fb.momentum[2],
-                               fb.velocity[0], fb.velocity[1], fb.velocity[2], fb.volume_open});
-    w.put(p + "face" + std::to_string(face) + "_queue", std::vector<double>(fb.queue.begin(), fb.queue.end()));
+  std::vector<std::vector<double>> queues(kFaces);
+  if (!load) {
+    for (int face = 0; face < kFaces; ++face) {
+      const FaceBalance& fb = faces_[face];
+      units.insert(units.end(), {fb.counted, fb.inserted, fb.removed});
+      counts.insert(counts.end(), {fb.parcels, fb.n_inserted, fb.n_removed, fb.backlog,
+                                   static_cast<std::uint64_t>(fb.growing), fb.warned ? 1u : 0u,
+                                   fb.warned_fill ? 1u : 0u});
+      reals.insert(reals.end(), {fb.fraction, fb.mass_open, fb.momentum[0], fb.momentum[1], fb.momentum[2],
+                                 fb.velocity[0], fb.velocity[1], fb.velocity[2], fb.volume_open});
+      queues[face].assign(fb.queue.begin(), fb.queue.end());
+    }
+    units.insert(units.end(), {outflow_.fine, outflow_.coarse, outflow_.sink});
   }
-  units.insert(units.end(), {outflow_.fine, outflow_.coarse, outflow_.sink});
-  put_mass_units(w, p + "units", units);
-  w.put(p + "face_counts", counts);
-  w.put(p + "face_reals", reals);
+  mass_units_field(f, "units", units);
+  f("face_counts", counts);
+  f("face_reals", reals);
+  for (int face = 0; face < kFaces; ++face) f("face" + std::to_string(face) + "_queue", queues[face]);
+  if (load) {
+    if (units.size() != 3 * kFaces + 3 || counts.size() != 7 * kFaces || reals.size() != 9 * kFaces)
+      f.reader().fail(p + "units", "does not hold the books of a coupling's six faces");
+    for (int face = 0; face < kFaces; ++face) {
+      FaceBalance& fb = faces_[face];
+      const MassUnits* u = &units[3 * face];
+      fb.counted = u[0], fb.inserted = u[1], fb.removed = u[2];
+      const std::uint64_t* c = &counts[7 * face];
+      fb.parcels = c[0], fb.n_inserted = c[1], fb.n_removed = c[2], fb.backlog = c[3];
+      fb.growing = static_cast<int>(c[4]), fb.warned = c[5] != 0, fb.warned_fill = c[6] != 0;
+      const double* x = &reals[9 * face];
+      fb.fraction = x[0], fb.mass_open = x[1];
+      for (int a = 0; a < 3; ++a) fb.momentum[a] = x[2 + a], fb.velocity[a] = x[5 + a];
+      fb.volume_open = x[8];
+      fb.queue.assign(queues[face].begin(), queues[face].end());
+    }
+    outflow_.fine = units[3 * kFaces], outflow_.coarse = units[3 * kFaces + 1], outflow_.sink = units[3 * kFaces + 2];
+  }
   // the followed parcels and the counted ids, sorted (the maps' order is not
   // the state: nothing iterates them in an order that changes a result)
   std::vector<std::uint64_t> ids;
-  for (const auto& [id, v] : coarse_last_) ids.push_back(id);
-  std::sort(ids.begin(), ids.end());
   std::vector<double> last;
-  for (std::uint64_t id : ids) {
-    const auto& v = coarse_last_.at(id);
-    last.insert(last.end(), v.begin(), v.end());
+  if (!load) {
+    for (const auto& [id, v] : coarse_last_) ids.push_back(id);
+    std::sort(ids.begin(), ids.end());
+    for (std::uint64_t id : ids) {
+      const auto& v = coarse_last_.at(id);
+      last.insert(last.end(), v.begin(), v.end());
+    }
   }
-  w.put(p + "followed_ids", ids);
-  w.put(p + "followed", last);
+  f("followed_ids", ids);
+  f("followed", last);
+  if (load) {
+    if (last.size() != 4 * ids.size()) f.reader().fail(p + "followed", "disagrees with followed_ids in length");
+    coarse_last_.clear();
+    for (std::size_t k = 0; k < ids.size(); ++k)
+      coarse_last_[ids[k]] = {last[4 * k], last[4 * k + 1], last[4 * k + 2], last[4 * k + 3]};
+  }
   for (int face = 0; face < kFaces; ++face) {
     std::vector<std::uint64_t> counted(counted_ids_[face].begin(), counted_ids_[face].end());
     std::sort(counted.begin(), counted.end());
-    w.put(p + "face" + std::to_string(face) + "_counted_ids", counted);
+    f("face" + std::to_string(face) + "_counted_ids", counted);
+    if (load) counted_ids_[face] = std::unordered_set<std::uint64_t>(counted.begin(), counted.end());
   }
-  std::ostringstream rng;
-  rng << rng_;
-  w.put_text(p + "rng", rng.str());
-  w.put(p + "counters", std::vector<std::uint64_t>{controls_, transfers_, since_transfer_, outflow_.n_sink,
-                                                   grid_files_.index()});
-  w.put(p + "reals", std::vector<double>{last_t_, last_row_t_, fine_dmax_, timing_.count, timing_.transfer,
-                                         timing_.control, timing_.averaging});
-  std::uint64_t balance_bytes = 0;
-  if (balance_) {
+  std::string rng_text;
+  if (!load) {
+    std::ostringstream rng;
+    rng << rng_;
+    rng_text = rng.str();
+  }
+  f("rng", rng_text);
+  if (load) {
+    std::istringstream rng(rng_text);
+    rng >> rng_;
+    if (!rng) f.reader().fail(p + "rng", "does not hold the state of a 64-bit Mersenne Twister");
+  }
+  std::uint64_t grid_files = grid_files_.index(), balance_bytes = 0;
+  f("controls", controls_);
+  f("transfers", transfers_);
+  f("since_transfer", since_transfer_);
+  f("sink_parcels", outflow_.n_sink);
+  f("grid_files", grid_files);
+  f("last_t", last_t_);
+  f("last_row_t", last_row_t_);
+  f("fine_dmax", fine_dmax_);
+  f("timing_count", timing_.count);
+  f("timing_transfer", timing_.transfer);
+  f("timing_control", timing_.control);
+  f("timing_averaging", timing_.averaging);
+  if (balance_ && !load) {
     balance_->flush();
     balance_bytes = balance_->size();
   }
-  w.put_scalar<std::uint64_t>(p + "balance_bytes", balance_bytes);
-  w.put(p + "vtk_fine_times", vtk_fine_ ? vtk_fine_->frame_times() : std::vector<double>{});
-  w.put(p + "vtk_coarse_times", vtk_coarse_ ? vtk_coarse_->frame_times() : std::vector<double>{});
-  for (const auto& [c, key] : controllers_of(spec_))
-    if (c->enabled) {
-      const auto bytes = c->model->save_state();
-      w.put_text(p + key, std::string(bytes.begin(), bytes.end()));
+  f("balance_bytes", balance_bytes);
+  std::vector<double> fine_times = vtk_fine_ ? vtk_fine_->frame_times() : std::vector<double>{};
+  std::vector<double> coarse_times = vtk_coarse_ ? vtk_coarse_->frame_times() : std::vector<double>{};
+  f("vtk_fine_times", fine_times);
+  f("vtk_coarse_times", coarse_times);
+  if (load) {
+    grid_files_.resume(grid_files);
+    if (balance_ && balance_bytes > 0) balance_->resume(balance_bytes);
+    if (vtk_fine_) vtk_fine_->resume(fine_times);
+    if (vtk_coarse_) vtk_coarse_->resume(coarse_times);
+  }
+  // the controllers' states (ABI 2.3 save_state), in their own format
+  for (const auto& [c, key] : controllers_of(spec_)) {
+    if (!c->enabled) continue;
+    std::string bytes;
+    if (!load) {
+      const auto state = c->model->save_state();
+      bytes.assign(state.begin(), state.end());
     }
+    f(key, bytes);
+    if (!load) continue;
+    try {
+      c->model->load_state(std::vector<unsigned char>(bytes.begin(), bytes.end()));
+    } catch (const PluginError& e) {
+      f.reader().fail(p + key, std::string("holds a state the controller refuses: ") + e.what());
+    }
+  }
+}
+
+void Coupling::save(ArchiveWriter& w, const std::string& p) {
+  fine_grid_->save(w, p + "fine_grid/");
+  coarse_grid_->save(w, p + "coarse_grid/");
+  save_fields(w, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 void Coupling::load(const ArchiveReader& r, const std::string& p) {
   fine_grid_->load(r, p + "fine_grid/");
   coarse_grid_->load(r, p + "coarse_grid/");
-  const auto units = get_mass_units(r, p + "units");
-  const auto counts = r.get<std::uint64_t>(p + "face_counts");
-  const auto reals = r.get<double>(p + "face_reals");
-  if (units.size() != 3 * kFaces + 3 || counts.size() != 7 * kFaces || reals.size() != 9 * kFaces)
-    r.fail(p + "units", "does not hold the books of a coupling's six faces");
-  for (int face = 0; face < kFaces; ++face) {
-    FaceBalance& fb = faces_[face];
-    const MassUnits* u = &units[3 * face];
-    fb.counted = u[0], fb.inserted = u[1], fb.removed = u[2];
-    const std::uint64_t* c = &counts[7 * face];
-    fb.parcels = c[0], fb.n_inserted = c[1], fb.n_removed = c[2], fb.backlog = c[3];
-    fb.growing = static_cast<int>(c[4]), fb.warned = c[5] != 0, fb.warned_fill = c[6] != 0;
-    const double* x = &reals[9 * face];
-    fb.fraction = x[0], fb.mass_open = x[1];
-    for (int a = 0; a < 3; ++a) fb.momentum[a] = x[2 + a], fb.velocity[a] = x[5 + a];
-    fb.volume_open = x[8];
-    const auto queue = r.get<double>(p + "face" + std::to_string(face) + "_queue");
-    fb.queue.assign(queue.begin(), queue.end());
-  }
-  outflow_.fine = units[3 * kFaces], outflow_.coarse = units[3 * kFaces + 1], outflow_.sink = units[3 * kFaces + 2];
-  const auto ids = r.get<std::uint64_t>(p + "followed_ids");
-  const auto last = r.get<double>(p + "followed");
-  if (last.size() != 4 * ids.size()) r.fail(p + "followed", "disagrees with followed_ids in length");
-  coarse_last_.clear();
-  for (std::size_t k = 0; k < ids.size(); ++k)
-    coarse_last_[ids[k]] = {last[4 * k], last[4 * k + 1], last[4 * k + 2], last[4 * k + 3]};
-  for (int face = 0; face < kFaces; ++face) {
-    const auto counted = r.get<std::uint64_t>(p + "face" + std::to_string(face) + "_counted_ids");
-    counted_ids_[face] = std::unordered_set<std::uint64_t>(counted.begin(), counted.end());
-  }
-  std::istringstream rng(r.text(p + "rng"));
-  rng >> rng_;
-  if (!rng) r.fail(p + "rng", "does not hold the state of a 64-bit Mersenne Twister");
-  const auto n = r.get<std::uint64_t>(p + "counters");
-  const auto v = r.get<double>(p + "reals");
-  if (n.size() != 5 || v.size() != 7) r.fail(p + "counters", "does not hold a coupling's counters");
-  controls_ = n[0], transfers_ = n[1], since_transfer_ = n[2], outflow_.n_sink = n[3];
-  grid_files_.resume(n[4]);
-  last_t_ = v[0], last_row_t_ = v[1], fine_dmax_ = v[2];
-  timing_ = Timing{v[3], v[4], v[5], v[6]};
-  const auto balance_bytes = r.scalar<std::uint64_t>(p + "balance_bytes");
-  if (balance_ && balance_bytes > 0) balance_->resume(balance_bytes);
-  if (vtk_fine_) vtk_fine_->resume(r.get<double>(p + "vtk_fine_times"));
-  if (vtk_coarse_) vtk_coarse_->resume(r.get<double>(p + "vtk_coarse_times"));
-  for (const auto& [c, key] : controllers_of(spec_)) {
-    if (!c->enabled) continue;
-    const std::string bytes = r.text(p + key);
-    try {
-      c->model->load_state(std::vector<unsigned char>(bytes.begin(), bytes.end()));
-    } catch (const PluginError& e) {
-      r.fail(p + key, std::string("holds a state the controller refuses: ") + e.what());
-    }
-  }
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& subdomains, const ParticleStore& all,

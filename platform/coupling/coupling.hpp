@@ -61,6 +61,7 @@ namespace domel::platform {
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 class RunRanks;
 
 namespace io {
@@ -176,6 +177,8 @@ class Coupling {
   /// the files continued. Throws ConfigError naming the section when the
   /// checkpoint holds another coupling.
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load, field by field (core/archive.hpp).
+  void fields(CheckpointFields& f);
 
   /// Close the balance file and describe the coupling for summary.json;
   /// `fine` holds all the fine level's particles (on ranks: gathered).

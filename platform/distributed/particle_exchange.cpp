@@ -295,7 +295,7 @@ void GhostExchange::reverse_counts(ParticleStore& s, const Communicator& comm) c
 }
 
 
-void GhostExchange::save(ArchiveWriter& w, const std::string& p) const {
+void GhostExchange::fields(CheckpointFields& f, int ranks) {
   std::vector<std::uint64_t> first(first_.begin(), first_.end()), counts;
   std::vector<std::uint32_t> sent;
   std::vector<double> shift;
@@ -304,17 +304,13 @@ void GhostExchange::save(ArchiveWriter& w, const std::string& p) const {
     sent.insert(sent.end(), sent_[r].begin(), sent_[r].end());
     for (const auto& a : shift_[r]) shift.insert(shift.end(), a.begin(), a.end());
   }
-  w.put(p + "first", first);
-  w.put(p + "sent_counts", counts);
-  w.put(p + "sent", sent);
-  w.put(p + "shift", shift);
-}
-
-void GhostExchange::load(const ArchiveReader& r, const std::string& p, int ranks) {
-  const auto first = r.get<std::uint64_t>(p + "first");
-  const auto counts = r.get<std::uint64_t>(p + "sent_counts");
-  const auto sent = r.get<std::uint32_t>(p + "sent");
-  const auto shift = r.get<double>(p + "shift");
+  f("first", first);
+  f("sent_counts", counts);
+  f("sent", sent);
+  f("shift", shift);
+  if (!f.loading()) return;
+  const ArchiveReader& r = f.reader();
+  const std::string& p = f.prefix();
   const auto n = static_cast<std::size_t>(ranks);
   if (first.size() != n + 1 || counts.size() != n)
     r.fail(p + "first", "was written on " + std::to_string(counts.size()) + " ranks, not " + std::to_string(ranks));
@@ -337,6 +333,14 @@ void GhostExchange::load(const ArchiveReader& r, const std::string& p, int ranks
       sent_[q].push_back(sent[at]);
       shift_[q].push_back({shift[3 * at], shift[3 * at + 1], shift[3 * at + 2]});
     }
+}
+
+void GhostExchange::save(ArchiveWriter& w, const std::string& p) const {
+  save_fields(w, p, [&](CheckpointFields& f) { const_cast<GhostExchange*>(this)->fields(f, 0); });
+}
+
+void GhostExchange::load(const ArchiveReader& r, const std::string& p, int ranks) {
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f, ranks); });
 }
 
 }  // namespace domel::platform

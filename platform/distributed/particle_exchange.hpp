@@ -89,6 +89,9 @@ class GhostExchange {
   /// reverse() read until the next build).
   void save(ArchiveWriter& w, const std::string& prefix) const;
   void load(const ArchiveReader& r, const std::string& prefix, int ranks);
+  /// Both directions of save and load, field by field (core/archive.hpp);
+  /// `ranks` the run's rank count (loading).
+  void fields(CheckpointFields& f, int ranks);
 
  private:
   /// Throws unless s holds the particles of the last build.

@@ -65,16 +65,25 @@ std::size_t SubdomainRanks::migrate(ParticleStore& s, std::size_t owned, const s
 
 void SubdomainRanks::save(ArchiveWriter& w, const std::string& p) const {
   ghosts_.save(w, p + "ghosts/");
-  const RankTraffic& t = traffic_;
-  w.put(p + "traffic", std::vector<std::uint64_t>{t.migrations, t.migrated, t.histories_sent, t.ghost_builds, t.ghosts,
-                                                  t.updates, t.update_bytes, t.reverses, t.reverse_bytes});
+  save_fields(w, p + "traffic/", [&](CheckpointFields& f) { const_cast<SubdomainRanks*>(this)->traffic_fields(f); });
 }
 
 void SubdomainRanks::load(const ArchiveReader& r, const std::string& p) {
   ghosts_.load(r, p + "ghosts/", comm_.size());
-  const auto v = r.get<std::uint64_t>(p + "traffic");
-  if (v.size() != 9) r.fail(p + "traffic", "holds " + std::to_string(v.size()) + " counters, expected 9");
-  traffic_ = {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]};
+  load_fields(r, p + "traffic/", [&](CheckpointFields& f) { traffic_fields(f); });
+}
+
+void SubdomainRanks::traffic_fields(CheckpointFields& f) {
+  RankTraffic& t = traffic_;
+  f("migrations", t.migrations);
+  f("migrated", t.migrated);
+  f("histories_sent", t.histories_sent);
+  f("ghost_builds", t.ghost_builds);
+  f("ghosts", t.ghosts);
+  f("updates", t.updates);
+  f("update_bytes", t.update_bytes);
+  f("reverses", t.reverses);
+  f("reverse_bytes", t.reverse_bytes);
 }
 
 void SubdomainRanks::build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) {

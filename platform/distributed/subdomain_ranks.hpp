@@ -47,6 +47,8 @@ class SubdomainRanks final : public RankExchange {
   int size() const override { return comm_.size(); }
   void save(ArchiveWriter& w, const std::string& prefix) const override;
   void load(const ArchiveReader& r, const std::string& prefix) override;
+  /// The traffic counters in a checkpoint, both directions (core/archive.hpp).
+  void traffic_fields(CheckpointFields& f);
   std::size_t ghosts_begin() const override { return ghosts_.owned(); }
   std::size_t ghosts_end() const override { return ghosts_.size(); }
 

@@ -415,149 +415,129 @@ nlohmann::json ParticleFlow::summary(const std::vector<std::unique_ptr<Subdomain
 
 namespace domel::platform {
 
-void put_mass_units(ArchiveWriter& w, const std::string& key, const std::vector<MassUnits>& v) {
+void mass_units_field(CheckpointFields& f, const std::string& key, std::vector<MassUnits>& v) {
   std::vector<std::uint64_t> halves;
   for (MassUnits u : v) {
     const auto bits = static_cast<unsigned __int128>(u);
     halves.push_back(static_cast<std::uint64_t>(bits));
     halves.push_back(static_cast<std::uint64_t>(bits >> 64));
   }
-  w.put(key, halves);
-}
-
-std::vector<MassUnits> get_mass_units(const ArchiveReader& r, const std::string& key) {
-  const auto halves = r.get<std::uint64_t>(key);
-  if (halves.size() % 2) r.fail(key, "does not hold pairs of 64-bit halves");
-  std::vector<MassUnits> v;
+  f(key, halves);
+  if (!f.loading()) return;
+  if (halves.size() % 2) f.reader().fail(f.prefix() + key, "does not hold pairs of 64-bit halves");
+  v.clear();
   for (std::size_t k = 0; k < halves.size(); k += 2)
     v.push_back(static_cast<MassUnits>((static_cast<unsigned __int128>(halves[k + 1]) << 64) | halves[k]));
-  return v;
 }
 
 namespace {
 
-void put_series(ArchiveWriter& w, const std::string& p, const FlowSeries& s) {
-  w.put(p + "series_t", s.t);
-  w.put(p + "series_value", s.value);
-}
-
-void get_series(const ArchiveReader& r, const std::string& p, FlowSeries& s) {
-  r.get_into(p + "series_t", s.t);
-  r.get_into(p + "series_value", s.value);
-  if (s.t.size() != s.value.size()) r.fail(p + "series_t", "disagrees with series_value in length");
+void series_fields(CheckpointFields& f, const std::string& at, FlowSeries& s) {
+  f(at + "series_t", s.t);
+  f(at + "series_value", s.value);
+  if (f.loading() && s.t.size() != s.value.size())
+    f.reader().fail(f.prefix() + at + "series_t", "disagrees with series_value in length");
 }
 
 }  // namespace
 
-void ParticleFlow::save(ArchiveWriter& w, const std::string& p) {
-  w.put_scalar<std::uint64_t>(p + "next_id", next_id);
+void ParticleFlow::fields(CheckpointFields& f, std::size_t subdomains) {
+  const bool load = f.loading();
+  const std::string& p = f.prefix();
+  auto same_count = [&](const std::string& key, std::uint64_t there, std::size_t here, const char* what) {
+    if (load && there != here)
+      f.reader().fail(p + key, "holds " + std::to_string(there) + " " + what + "; the scenario has " +
+                                   std::to_string(here) + " (a restart keeps the particle flow of the checkpointed run)");
+  };
+  f("next_id", next_id);
   std::vector<MassUnits> units;
   std::vector<std::uint64_t> counts;
   for (const MassAccount& a : accounts_) {
     units.insert(units.end(), {a.inserted, a.removed});
     counts.insert(counts.end(), {a.n_inserted, a.n_removed});
   }
-  put_mass_units(w, p + "accounts_units", units);
-  w.put(p + "accounts_counts", counts);
-  w.put_scalar<std::uint64_t>(p + "checks", checks_.index());
-  w.put(p + "last_row", std::vector<double>(1, last_row_t_));
-  w.put(p + "last_row_values", last_row_);
-  w.put_scalar<std::uint64_t>(p + "pours", pours.size());
+  mass_units_field(f, "accounts_units", units);
+  f("accounts_counts", counts);
+  if (load) {
+    if (units.size() != 2 * accounts_.size() || counts.size() != 2 * accounts_.size())
+      f.reader().fail(p + "accounts_units", "holds the books of another number of subdomains");
+    for (std::size_t k = 0; k < accounts_.size(); ++k)
+      accounts_[k] = MassAccount{units[2 * k], units[2 * k + 1], counts[2 * k], counts[2 * k + 1]};
+  }
+  std::uint64_t checks = checks_.index();
+  f("checks", checks);
+  if (load) checks_.resume(checks);
+  f("last_row", last_row_t_);
+  f("last_row_values", last_row_);
+  std::uint64_t n = pours.size();
+  f("pours", n);
+  same_count("pours", n, pours.size(), "pours");
   for (std::size_t k = 0; k < pours.size(); ++k) {
-    const Pour& q = pours[k];
-    const std::string pp = p + "pour" + std::to_string(k) + "/";
-    w.put(pp + "counts", std::vector<std::uint64_t>{q.schedule.index(), q.events, q.inserted, q.warned ? 1u : 0u});
-    w.put(pp + "masses", std::vector<double>{q.inserted_mass, q.shortfall});
+    Pour& q = pours[k];
+    const std::string at = "pour" + std::to_string(k) + "/";
+    std::uint64_t events = q.schedule.index();
+    f(at + "schedule", events);
+    f(at + "events", q.events);
+    f(at + "inserted", q.inserted);
+    f(at + "warned", q.warned);
+    f(at + "inserted_mass", q.inserted_mass);
+    f(at + "shortfall", q.shortfall);
+    if (load) q.schedule.resume(events);
   }
-  w.put_scalar<std::uint64_t>(p + "deletions", deletions.size());
+  n = deletions.size();
+  f("deletions", n);
+  same_count("deletions", n, deletions.size(), "deletion regions");
   for (std::size_t k = 0; k < deletions.size(); ++k) {
-    const DeletionRegion& d = deletions[k];
-    const std::string dp = p + "deletion" + std::to_string(k) + "/";
-    w.put_scalar<std::uint64_t>(dp + "removed", d.removed);
-    w.put_scalar(dp + "removed_mass", d.removed_mass);
-    put_series(w, dp, d.series);
+    DeletionRegion& d = deletions[k];
+    const std::string at = "deletion" + std::to_string(k) + "/";
+    f(at + "removed", d.removed);
+    f(at + "removed_mass", d.removed_mass);
+    series_fields(f, at, d.series);
   }
-  w.put_scalar<std::uint64_t>(p + "planes", planes.size());
+  n = planes.size();
+  f("planes", n);
+  same_count("planes", n, planes.size(), "mass-flow planes");
   for (std::size_t k = 0; k < planes.size(); ++k) {
-    const MassFlowPlane& pl = planes[k];
-    const std::string pp = p + "plane" + std::to_string(k) + "/";
-    w.put_scalar(pp + "mass", pl.mass);
-    w.put_scalar<std::int64_t>(pp + "count", pl.count);
-    put_series(w, pp, pl.series);
-    w.put_scalar<std::uint64_t>(pp + "sides", pl.side.size());
+    MassFlowPlane& pl = planes[k];
+    const std::string at = "plane" + std::to_string(k) + "/";
+    f(at + "mass", pl.mass);
+    f(at + "count", pl.count);
+    series_fields(f, at, pl.series);
+    std::uint64_t sides = pl.side.size();
+    f(at + "sides", sides);
+    same_count(at + "sides", sides, subdomains, "subdomains");
+    if (load) pl.side.assign(subdomains, {});
     for (std::size_t s = 0; s < pl.side.size(); ++s) {
-      std::vector<std::pair<std::uint64_t, signed char>> sorted(pl.side[s].begin(), pl.side[s].end());
-      std::sort(sorted.begin(), sorted.end());
+      // sorted by id: the map's order is not the state
       std::vector<std::uint64_t> ids;
-      std::vector<std::uint8_t> sides;
-      for (const auto& [id, side] : sorted) {
-        ids.push_back(id);
-        sides.push_back(side > 0 ? 1 : 0);
+      std::vector<std::uint8_t> positive;
+      if (!load) {
+        std::vector<std::pair<std::uint64_t, signed char>> sorted(pl.side[s].begin(), pl.side[s].end());
+        std::sort(sorted.begin(), sorted.end());
+        for (const auto& [id, side] : sorted) {
+          ids.push_back(id);
+          positive.push_back(side > 0 ? 1 : 0);
+        }
       }
-      w.put(pp + "side" + std::to_string(s) + "_ids", ids);
-      w.put(pp + "side" + std::to_string(s) + "_positive", sides);
+      const std::string key = at + "side" + std::to_string(s);
+      f(key + "_ids", ids);
+      f(key + "_positive", positive);
+      if (!load) continue;
+      if (ids.size() != positive.size()) f.reader().fail(p + key + "_ids", "disagrees with its sides");
+      pl.side[s].reserve(ids.size());
+      for (std::size_t e = 0; e < ids.size(); ++e) pl.side[s].emplace(ids[e], positive[e] ? 1 : -1);
     }
   }
+}
+
+void ParticleFlow::save(ArchiveWriter& w, const std::string& p) {
+  save_fields(w, p, [&](CheckpointFields& f) { fields(f, accounts_.size()); });
 }
 
 void ParticleFlow::restore(const ArchiveReader& r, const std::string& p,
                            std::vector<std::unique_ptr<Subdomain>>& subdomains) {
   start(subdomains);  // the schedules and sizes; every value is then replaced by the checkpoint's
-  auto expect_count = [&](const std::string& key, std::size_t here, const char* what) {
-    const auto there = r.scalar<std::uint64_t>(key);
-    if (there != here)
-      r.fail(key, "holds " + std::to_string(there) + " " + what + "; the scenario has " + std::to_string(here) +
-                      " (a restart keeps the particle flow of the checkpointed run)");
-  };
-  next_id = r.scalar<std::uint64_t>(p + "next_id");
-  const auto units = get_mass_units(r, p + "accounts_units");
-  const auto counts = r.get<std::uint64_t>(p + "accounts_counts");
-  if (units.size() != 2 * accounts_.size() || counts.size() != 2 * accounts_.size())
-    r.fail(p + "accounts_units", "holds the books of another number of subdomains");
-  for (std::size_t k = 0; k < accounts_.size(); ++k)
-    accounts_[k] = MassAccount{units[2 * k], units[2 * k + 1], counts[2 * k], counts[2 * k + 1]};
-  checks_.resume(r.scalar<std::uint64_t>(p + "checks"));
-  last_row_t_ = r.get<double>(p + "last_row").at(0);
-  r.get_into(p + "last_row_values", last_row_);
-  expect_count(p + "pours", pours.size(), "pours");
-  for (std::size_t k = 0; k < pours.size(); ++k) {
-    Pour& q = pours[k];
-    const std::string pp = p + "pour" + std::to_string(k) + "/";
-    const auto c = r.get<std::uint64_t>(pp + "counts");
-    const auto m = r.get<double>(pp + "masses");
-    if (c.size() != 4 || m.size() != 2) r.fail(pp + "counts", "does not hold a pour's progress");
-    q.schedule.resume(c[0]);
-    q.events = c[1];
-    q.inserted = c[2];
-    q.warned = c[3] != 0;
-    q.inserted_mass = m[0];
-    q.shortfall = m[1];
-  }
-  expect_count(p + "deletions", deletions.size(), "deletion regions");
-  for (std::size_t k = 0; k < deletions.size(); ++k) {
-    DeletionRegion& d = deletions[k];
-    const std::string dp = p + "deletion" + std::to_string(k) + "/";
-    d.removed = r.scalar<std::uint64_t>(dp + "removed");
-    d.removed_mass = r.scalar<double>(dp + "removed_mass");
-    get_series(r, dp, d.series);
-  }
-  expect_count(p + "planes", planes.size(), "mass-flow planes");
-  for (std::size_t k = 0; k < planes.size(); ++k) {
-    MassFlowPlane& pl = planes[k];
-    const std::string pp = p + "plane" + std::to_string(k) + "/";
-    pl.mass = r.scalar<double>(pp + "mass");
-    pl.count = r.scalar<std::int64_t>(pp + "count");
-    get_series(r, pp, pl.series);
-    expect_count(pp + "sides", subdomains.size(), "subdomains");
-    pl.side.assign(subdomains.size(), {});
-    for (std::size_t s = 0; s < subdomains.size(); ++s) {
-      const auto ids = r.get<std::uint64_t>(pp + "side" + std::to_string(s) + "_ids");
-      const auto pos = r.get<std::uint8_t>(pp + "side" + std::to_string(s) + "_positive");
-      if (ids.size() != pos.size()) r.fail(pp + "side" + std::to_string(s) + "_ids", "disagrees with its sides");
-      pl.side[s].reserve(ids.size());
-      for (std::size_t e = 0; e < ids.size(); ++e) pl.side[s].emplace(ids[e], pos[e] ? 1 : -1);
-    }
-  }
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f, subdomains.size()); });
 }
 
 }  // namespace domel::platform

@@ -35,6 +35,7 @@ namespace domel::platform {
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 /// Candidate particles an insertion model placed (parcel radii, alpha
 /// applied); for a mixture, each one's component (else empty).
@@ -76,9 +77,9 @@ InsertionCandidates request_insertion(const ModelInstance& model, const domel_re
 using MassUnits = __int128;
 MassUnits mass_units(double kg);
 double mass_kg(MassUnits u);
-/// Exact books in a checkpoint: each value as two 64-bit halves.
-void put_mass_units(ArchiveWriter& w, const std::string& key, const std::vector<MassUnits>& v);
-std::vector<MassUnits> get_mass_units(const ArchiveReader& r, const std::string& key);
+/// Exact books in a checkpoint (core/archive.hpp, CheckpointFields): each
+/// value as two 64-bit halves.
+void mass_units_field(CheckpointFields& f, const std::string& key, std::vector<MassUnits>& v);
 
 struct MassAccount {
   MassUnits inserted = 0;
@@ -211,6 +212,9 @@ class ParticleFlow final : public Component, public ProbeSource {
   /// or planes are not the checkpoint's.
   void save(ArchiveWriter& w, const std::string& prefix) override;
   void restore(const ArchiveReader& r, const std::string& prefix, std::vector<std::unique_ptr<Subdomain>>& subdomains);
+  /// Both directions of save and restore, field by field (core/archive.hpp),
+  /// for a run of `subdomains` levels.
+  void fields(CheckpointFields& f, std::size_t subdomains);
 
  private:
   void pour(Pour& p, double t, Subdomain& sd);

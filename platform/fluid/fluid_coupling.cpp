@@ -232,43 +232,57 @@ void FluidCoupling::write_fields(std::uint64_t tick, double t, bool final, const
   fields_out_->write(t, image);
 }
 
-void FluidCoupling::save(ArchiveWriter& w, const std::string& p) {
-  const auto bytes = spec_.model->save_state();
-  w.put_text(p + "coupler_state", std::string(bytes.begin(), bytes.end()));
-  w.put(p + "counts", std::vector<std::uint64_t>{exchanges_, has_limits_ ? 1u : 0u, last_limits_.solver_iterations,
-                                                 spec_.levels.size(), fields_.index()});
-  std::vector<double> reals = {seconds_, last_limits_.max_interval, last_limits_.solver_residual};
-  for (const auto& f : net_force_) reals.insert(reals.end(), f.begin(), f.end());
-  w.put(p + "reals", reals);
-  w.put_text(p + "limit", last_limit_);
-  w.put(p + "field_times", fields_out_ ? fields_out_->frame_times() : std::vector<double>{});
-}
-
-void FluidCoupling::load(const ArchiveReader& r, const std::string& p, const std::filesystem::path& out) {
-  const std::string bytes = r.text(p + "coupler_state");
-  try {
-    spec_.model->load_state(std::vector<unsigned char>(bytes.begin(), bytes.end()));
-  } catch (const PluginError& e) {
-    r.fail(p + "coupler_state", std::string("holds a state the fluid coupler refuses: ") + e.what());
+void FluidCoupling::fields(CheckpointFields& f, const std::filesystem::path& out) {
+  const bool load = f.loading();
+  std::string state;
+  if (!load) {
+    const auto bytes = spec_.model->save_state();
+    state.assign(bytes.begin(), bytes.end());
   }
-  const auto n = r.get<std::uint64_t>(p + "counts");
-  const auto v = r.get<double>(p + "reals");
-  if (n.size() != 5 || n[3] != spec_.levels.size() || v.size() != 3 + 3 * spec_.levels.size())
-    r.fail(p + "counts", "does not hold the state of a fluid shared by " + std::to_string(spec_.levels.size()) +
-                             " level(s)");
-  exchanges_ = n[0];
-  has_limits_ = n[1] != 0;
-  last_limits_.solver_iterations = static_cast<uint32_t>(n[2]);
-  fields_.resume(n[4]);
-  seconds_ = v[0], last_limits_.max_interval = v[1], last_limits_.solver_residual = v[2];
+  f("coupler_state", state);
+  if (load) {
+    try {
+      spec_.model->load_state(std::vector<unsigned char>(state.begin(), state.end()));
+    } catch (const PluginError& e) {
+      f.reader().fail(f.prefix() + "coupler_state", std::string("holds a state the fluid coupler refuses: ") + e.what());
+    }
+  }
+  std::uint64_t levels = spec_.levels.size(), fields_written = fields_.index(), iterations = last_limits_.solver_iterations;
+  f("levels", levels);
+  if (load && levels != spec_.levels.size())
+    f.reader().fail(f.prefix() + "levels", "does not hold the state of a fluid shared by " +
+                                               std::to_string(spec_.levels.size()) + " level(s)");
+  f("exchanges", exchanges_);
+  f("has_limits", has_limits_);
+  f("solver_iterations", iterations);
+  f("fields_written", fields_written);
+  f("seconds", seconds_);
+  f("max_interval", last_limits_.max_interval);
+  f("solver_residual", last_limits_.solver_residual);
+  std::vector<double> net;
+  for (const auto& v : net_force_) net.insert(net.end(), v.begin(), v.end());
+  f("net_force", net);
+  f("limit", last_limit_);
+  std::vector<double> times = fields_out_ ? fields_out_->frame_times() : std::vector<double>{};
+  f("field_times", times);
+  if (!load) return;
+  if (net.size() != 3 * net_force_.size()) f.reader().fail(f.prefix() + "net_force", "holds another number of levels");
   for (std::size_t L = 0; L < net_force_.size(); ++L)
-    for (int d = 0; d < 3; ++d) net_force_[L][d] = v[3 + 3 * L + d];
-  last_limit_ = r.text(p + "limit");
-  const auto times = r.get<double>(p + "field_times");
+    for (int d = 0; d < 3; ++d) net_force_[L][d] = net[3 * L + d];
+  last_limits_.solver_iterations = static_cast<uint32_t>(iterations);
+  fields_.resume(fields_written);
   if (!times.empty() && (!ranks_ || ranks_->rank() == 0)) {  // rank 0 writes the fields
     fields_out_ = std::make_unique<io::FieldImageSeries>(out, "fluid");
     fields_out_->resume(times);
   }
+}
+
+void FluidCoupling::save(ArchiveWriter& w, const std::string& p) {
+  save_fields(w, p, [&](CheckpointFields& f) { fields(f, {}); });
+}
+
+void FluidCoupling::load(const ArchiveReader& r, const std::string& p, const std::filesystem::path& out) {
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f, out); });
 }
 
 nlohmann::json FluidCoupling::summary() const {

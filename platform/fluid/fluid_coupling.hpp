@@ -36,6 +36,7 @@ class RunRanks;
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 namespace io {
 class FieldImageSeries;
@@ -102,6 +103,8 @@ class FluidCoupling final : public Component {
   void save(ArchiveWriter& w, const std::string& prefix) override;
   /// On a restart, before the first exchange; `out` is the run's folder.
   void load(const ArchiveReader& r, const std::string& prefix, const std::filesystem::path& out);
+  /// Both directions of save and load (core/archive.hpp); `out`: the run's folder (loading).
+  void fields(CheckpointFields& f, const std::filesystem::path& out);
 
   /// summary.json's "fluid" block: model, levels, interval, exchanges, time
   /// spent in the plugin, the last limit and solver figures, the net fluid

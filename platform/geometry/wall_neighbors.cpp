@@ -124,29 +124,27 @@ void WallNeighbors::build(const ParticleStore& s, const WallPrimitive& w, double
 
 namespace domel::platform {
 
-void WallNeighbors::save(ArchiveWriter& w, const std::string& p) const {
-  w.put(p + "particle", particle);
-  w.put(p + "particle_id", particle_id);
-  w.put(p + "triangle", triangle);
-  w.put(p + "history", history);
-  w.put(p + "touching", touching);
-  w.put_scalar(p + "built_time", built_time);
-  w.put_scalar<std::uint8_t>(p + "built", built ? 1 : 0);
-}
-
-void WallNeighbors::load(const ArchiveReader& r, const std::string& p) {
-  r.get_into(p + "particle", particle);
-  r.get_into(p + "particle_id", particle_id);
-  r.get_into(p + "triangle", triangle);
-  r.get_into(p + "history", history);
-  r.get_into(p + "touching", touching);
-  // a checkpoint written before motion lists: NaN, rebuilt at the first step
-  built_time = r.has(p + "built_time") ? r.scalar<double>(p + "built_time") : std::nan("");
-  built = r.scalar<std::uint8_t>(p + "built") != 0;
+void WallNeighbors::fields(CheckpointFields& f) {
+  f("particle", particle);
+  f("particle_id", particle_id);
+  f("triangle", triangle);
+  f("history", history);
+  f("touching", touching);
+  f("built_time", built_time);
+  f("built", built);
+  if (!f.loading()) return;
   grid_valid_ = false;
   if (particle_id.size() != particle.size() || touching.size() != particle.size() ||
       (!triangle.empty() && triangle.size() != particle.size()))
-    r.fail(p + "particle", "holds a wall candidate list whose arrays disagree in length");
+    f.reader().fail(f.prefix() + "particle", "holds a wall candidate list whose arrays disagree in length");
+}
+
+void WallNeighbors::save(ArchiveWriter& w, const std::string& p) const {
+  save_fields(w, p, [&](CheckpointFields& f) { const_cast<WallNeighbors*>(this)->fields(f); });
+}
+
+void WallNeighbors::load(const ArchiveReader& r, const std::string& p) {
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 }  // namespace domel::platform

@@ -18,6 +18,7 @@ namespace domel::platform {
 
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 /// Candidate particles of one wall primitive, with per-contact history.
 class WallNeighbors {
@@ -45,6 +46,8 @@ class WallNeighbors {
   /// triangle grid is a cache, rebuilt on demand).
   void save(ArchiveWriter& w, const std::string& prefix) const;
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load, field by field (core/archive.hpp).
+  void fields(CheckpointFields& f);
   std::vector<uint32_t> particle;      ///< particle indices at this build (ascending)
   std::vector<std::uint64_t> particle_id;  ///< their ids (history is carried over by id)
   std::vector<uint32_t> triangle;      ///< mesh walls: the candidate triangle of each entry

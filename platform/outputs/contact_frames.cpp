@@ -26,15 +26,24 @@ void ContactFrames::finish(RunContext&, nlohmann::json& summary) {
   summary["outputs"]["contacts"] = vtk_ ? "contacts.pvd" : "";
 }
 
+void ContactFrames::fields(CheckpointFields& f, std::uint64_t first) {
+  std::uint64_t index = frames_.index();
+  double period = frames_.period();
+  std::vector<double> times = vtk_ ? vtk_->frame_times() : std::vector<double>{};
+  f("index", index);
+  f("period", period);
+  f("times", times);
+  if (!f.loading()) return;
+  frames_.restore(index, period, first);
+  if (vtk_) vtk_->resume(times);
+}
+
 void ContactFrames::save(ArchiveWriter& w, const std::string& p) {
-  w.put_scalar<std::uint64_t>(p + "index", frames_.index());
-  w.put_scalar(p + "period", frames_.period());
-  w.put(p + "times", vtk_ ? vtk_->frame_times() : std::vector<double>{});
+  save_fields(w, p, [&](CheckpointFields& f) { fields(f, 0); });
 }
 
 void ContactFrames::load(RunContext& ctx, const ArchiveReader& r, const std::string& p) {
-  frames_.restore(r.scalar<std::uint64_t>(p + "index"), r.scalar<double>(p + "period"), ctx.first);
-  if (vtk_) vtk_->resume(r.get<double>(p + "times"));
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f, ctx.first); });
 }
 
 }  // namespace domel::platform

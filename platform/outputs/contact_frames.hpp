@@ -4,6 +4,7 @@
 // interval (io/contact_writer.hpp).
 #pragma once
 
+#include "core/archive.hpp"
 #include "io/contact_writer.hpp"
 #include "loop/component.hpp"
 
@@ -30,6 +31,8 @@ class ContactFrames final : public Component {
   const Cadence& cadence() const { return frames_; }
 
  private:
+  /// Both directions of the checkpoint (core/archive.hpp); `first`: a restart's macro step.
+  void fields(CheckpointFields& f, std::uint64_t first);
   double interval_;
   ContactSample& sample_;
   Cadence frames_;  ///< on every rank: it decides a gather

@@ -106,24 +106,29 @@ const std::vector<io::ContactRow>* ContactSample::rows_at(double t, double toler
   return rows_wanted_ && std::fabs(t - time_) <= tolerance ? &rows_ : nullptr;
 }
 
+void ContactSample::fields(CheckpointFields& f) {
+  f("time", time_);
+  std::vector<double> sums = sums_;
+  f("sums", sums);
+  if (f.loading() && sums.size() != sums_.size())
+    f.reader().fail(f.prefix() + "sums", "holds " + std::to_string(sums.size()) +
+                                             " values, this scenario's wall loads need " + std::to_string(sums_.size()));
+  sums_ = std::move(sums);
+  std::string bytes(reinterpret_cast<const char*>(rows_.data()), rows_.size() * sizeof(io::ContactRow));
+  f("rows", bytes);
+  if (!f.loading()) return;
+  if (bytes.size() % sizeof(io::ContactRow) != 0)
+    f.reader().fail(f.prefix() + "rows", "is not a whole number of contact rows");
+  rows_.resize(bytes.size() / sizeof(io::ContactRow));
+  if (!bytes.empty()) std::memcpy(rows_.data(), bytes.data(), bytes.size());
+}
+
 void ContactSample::save(ArchiveWriter& w, const std::string& prefix) {
-  w.put_scalar(prefix + "time", time_);
-  w.put(prefix + "sums", sums_);
-  w.put_text(prefix + "rows",
-             std::string(reinterpret_cast<const char*>(rows_.data()), rows_.size() * sizeof(io::ContactRow)));
+  save_fields(w, prefix, [&](CheckpointFields& f) { fields(f); });
 }
 
 void ContactSample::load(const ArchiveReader& r, const std::string& prefix) {
-  time_ = r.scalar<double>(prefix + "time");
-  std::vector<double> sums = r.get<double>(prefix + "sums");
-  if (sums.size() != sums_.size())
-    r.fail(prefix + "sums", "holds " + std::to_string(sums.size()) + " values, this scenario's wall loads need " +
-                                std::to_string(sums_.size()));
-  sums_ = std::move(sums);
-  const std::string bytes = r.text(prefix + "rows");
-  if (bytes.size() % sizeof(io::ContactRow) != 0) r.fail(prefix + "rows", "is not a whole number of contact rows");
-  rows_.resize(bytes.size() / sizeof(io::ContactRow));
-  if (!bytes.empty()) std::memcpy(rows_.data(), bytes.data(), bytes.size());
+  load_fields(r, prefix, [&](CheckpointFields& f) { fields(f); });
 }
 
 void ContactSample::init(RunContext& ctx) {

@@ -73,6 +73,8 @@ class ContactSample final : public Component, public ProbeSource {
   /// the macro step before the checkpoint, written after it).
   void save(ArchiveWriter& w, const std::string& prefix) override;
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load (core/archive.hpp).
+  void fields(CheckpointFields& f);
 
   // Component
   /// An output whose due ticks (macro steps) read the sample: the probes'
@@ -87,9 +89,7 @@ class ContactSample final : public Component, public ProbeSource {
   void before_steps(RunContext& ctx, const MacroStep& step) override;
   bool records_contacts(std::size_t, bool last) const override { return sampling_ && last; }
   void after_step(RunContext& ctx, std::size_t k, bool last) override;
-  void load(RunContext&, const ArchiveReader& r, const std::string& prefix) override {
-    if (r.has(prefix + "time")) load(r, prefix);  // absent when the checkpointed run had no sample
-  }
+  void load(RunContext&, const ArchiveReader& r, const std::string& prefix) override { load(r, prefix); }
   void probe_columns(std::vector<std::string>& names) const override;
   void probe_values(RunContext& ctx, double t, std::vector<double>& row) override;
 

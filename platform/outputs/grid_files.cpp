@@ -68,9 +68,23 @@ void GridFiles::save(ArchiveWriter& w, const std::string& prefix) {
   for (std::size_t g = 0; g < grids_.size(); ++g) {
     const std::string p = prefix + std::to_string(g) + "/";
     grids_[g]->save(w, p);
-    w.put(p + "files", std::vector<std::uint64_t>{files_[g].index(), csv_[g] ? csv_[g]->size() : 0u});
-    w.put_scalar(p + "write_interval", files_[g].period());
-    w.put(p + "vtk_times", vtk_[g] ? vtk_[g]->frame_times() : std::vector<double>{});
+    save_fields(w, p + "files/", [&](CheckpointFields& f) { file_fields(f, g, 0); });
+  }
+}
+
+void GridFiles::file_fields(CheckpointFields& f, std::size_t g, std::uint64_t first) {
+  std::uint64_t index = files_[g].index(), csv_bytes = csv_[g] ? csv_[g]->size() : 0u;
+  double period = files_[g].period();
+  std::vector<double> times = vtk_[g] ? vtk_[g]->frame_times() : std::vector<double>{};
+  f("index", index);
+  f("period", period);
+  f("csv_bytes", csv_bytes);
+  f("vtk_times", times);
+  if (!f.loading()) return;
+  files_[g].restore(index, period, first);
+  if (vtk_[g]) {
+    vtk_[g]->resume(times);
+    if (csv_bytes > 0) csv_[g]->resume(csv_bytes);
   }
 }
 
@@ -78,13 +92,7 @@ void GridFiles::load(RunContext& ctx, const ArchiveReader& r, const std::string&
   for (std::size_t g = 0; g < grids_.size(); ++g) {
     const std::string p = prefix + std::to_string(g) + "/";
     grids_[g]->load(r, p);
-    const auto files = r.get<std::uint64_t>(p + "files");
-    if (files.size() != 2) r.fail(p + "files", "does not hold a grid's file state");
-    files_[g].restore(files[0], r.scalar<double>(p + "write_interval"), ctx.first);
-    if (vtk_[g]) {
-      vtk_[g]->resume(r.get<double>(p + "vtk_times"));
-      if (files[1] > 0) csv_[g]->resume(files[1]);
-    }
+    load_fields(r, p + "files/", [&](CheckpointFields& f) { file_fields(f, g, ctx.first); });
   }
   // the walls' activity as the run last looked at it
   const double t_before = ctx.first > 0 ? static_cast<double>(ctx.first - 1) * ctx.macro : 0.0;

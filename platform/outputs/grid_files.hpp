@@ -10,6 +10,7 @@
 #pragma once
 
 #include "averaging/cell_grid.hpp"
+#include "core/archive.hpp"
 #include "io/cell_grid_output.hpp"
 #include "loop/component.hpp"
 
@@ -49,6 +50,8 @@ class GridFiles final : public Component {
 
  private:
   void refresh_accessible(RunContext& ctx, double t);
+  /// Grid g's files in a checkpoint, both directions (core/archive.hpp).
+  void file_fields(CheckpointFields& f, std::size_t g, std::uint64_t first);
 
   std::vector<GridSetup> setups_;
   std::vector<std::unique_ptr<CellGrid>> grids_;

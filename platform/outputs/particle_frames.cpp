@@ -33,17 +33,27 @@ void ParticleFrames::finish(RunContext&, nlohmann::json& summary) {
   summary["outputs"]["walls"] = walls_ ? "walls.pvd" : "";
 }
 
+void ParticleFrames::fields(CheckpointFields& f, std::uint64_t first) {
+  std::uint64_t index = frames_.index();
+  double period = frames_.period();
+  std::vector<double> times = vtk_ ? vtk_->frame_times() : std::vector<double>{};
+  std::vector<double> wall_times = walls_ ? walls_->frame_times() : std::vector<double>{};
+  f("index", index);
+  f("period", period);
+  f("times", times);
+  f("wall_times", wall_times);
+  if (!f.loading()) return;
+  frames_.restore(index, period, first);
+  if (vtk_) vtk_->resume(times);
+  if (walls_) walls_->resume(wall_times);
+}
+
 void ParticleFrames::save(ArchiveWriter& w, const std::string& p) {
-  w.put_scalar<std::uint64_t>(p + "index", frames_.index());
-  w.put_scalar(p + "period", frames_.period());
-  w.put(p + "times", vtk_ ? vtk_->frame_times() : std::vector<double>{});
-  w.put(p + "wall_times", walls_ ? walls_->frame_times() : std::vector<double>{});
+  save_fields(w, p, [&](CheckpointFields& f) { fields(f, 0); });
 }
 
 void ParticleFrames::load(RunContext& ctx, const ArchiveReader& r, const std::string& p) {
-  frames_.restore(r.scalar<std::uint64_t>(p + "index"), r.scalar<double>(p + "period"), ctx.first);
-  if (vtk_) vtk_->resume(r.get<double>(p + "times"));
-  if (walls_) walls_->resume(r.get<double>(p + "wall_times"));
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f, ctx.first); });
 }
 
 }  // namespace domel::platform

@@ -6,6 +6,7 @@
 // takes part in the gather of a frame and rank 0 writes it.
 #pragma once
 
+#include "core/archive.hpp"
 #include "io/vtk_writer.hpp"
 #include "io/wall_surfaces.hpp"
 #include "loop/component.hpp"
@@ -40,6 +41,8 @@ class ParticleFrames final : public Component {
   void load(RunContext& ctx, const ArchiveReader& r, const std::string& prefix) override;
 
  private:
+  /// Both directions of the checkpoint (core/archive.hpp); `first`: a restart's macro step.
+  void fields(CheckpointFields& f, std::uint64_t first);
   double interval_;
   std::vector<std::string> materials_;
   bool wall_surfaces_;

@@ -75,21 +75,27 @@ void ProbesOutput::finish(RunContext&, nlohmann::json& summary) {
   summary["outputs"]["probes"] = enabled() ? "probes.csv" : "";
 }
 
-void ProbesOutput::save(ArchiveWriter& w, const std::string& p) {
-  std::uint64_t bytes = 0;
-  if (file_) {
+void ProbesOutput::fields(CheckpointFields& f, std::uint64_t first) {
+  std::uint64_t row = rows_.index(), bytes = 0;
+  double period = rows_.period();
+  if (file_ && !f.loading()) {
     file_->flush();
     bytes = file_->size();
   }
-  w.put(p + "counts", std::vector<std::uint64_t>{rows_.index(), bytes});
-  w.put_scalar(p + "period", rows_.period());
+  f("row", row);
+  f("period", period);
+  f("bytes", bytes);
+  if (!f.loading()) return;
+  rows_.restore(row, period, first);
+  if (file_ && bytes > 0) file_->resume(bytes);
+}
+
+void ProbesOutput::save(ArchiveWriter& w, const std::string& p) {
+  save_fields(w, p, [&](CheckpointFields& f) { fields(f, 0); });
 }
 
 void ProbesOutput::load(RunContext& ctx, const ArchiveReader& r, const std::string& p) {
-  const auto c = r.get<std::uint64_t>(p + "counts");
-  if (c.size() != 2) r.fail(p + "counts", "does not hold probes.csv's state");
-  rows_.restore(c[0], r.scalar<double>(p + "period"), ctx.first);
-  if (file_ && c[1] > 0) file_->resume(c[1]);
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f, ctx.first); });
 }
 
 }  // namespace domel::platform

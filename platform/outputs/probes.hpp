@@ -6,6 +6,7 @@
 // particle flow's deletion and plane rates, wall loads and servo walls.
 #pragma once
 
+#include "core/archive.hpp"
 #include "io/csv_series.hpp"
 #include "loop/component.hpp"
 
@@ -44,6 +45,8 @@ class ProbesOutput final : public Component {
   }
 
  private:
+  /// Both directions of the checkpoint (core/archive.hpp); `first`: a restart's macro step.
+  void fields(CheckpointFields& f, std::uint64_t first);
   double interval_;
   std::vector<ProbeSource*> sources_;
   Cadence rows_;

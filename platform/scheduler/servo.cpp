@@ -47,24 +47,28 @@ void WallServos::append_values(double t, std::vector<double>& row) const {
   }
 }
 
-void WallServos::save(ArchiveWriter& w, const std::string& prefix) {
-  std::vector<double> v;
-  for (const WallServo& s : servos)
-    v.insert(v.end(), {s.state->s_ref, s.state->t_ref, s.state->velocity, s.measured});
-  w.put(prefix + "state", v);
-}
-
-void WallServos::load(const ArchiveReader& r, const std::string& prefix) {
-  const std::vector<double> v = r.get<double>(prefix + "state");
+void WallServos::fields(CheckpointFields& f) {
+  std::vector<double> v;  // per servo: travel reference, its time, velocity, the load measured
+  for (const WallServo& s : servos) v.insert(v.end(), {s.state->s_ref, s.state->t_ref, s.state->velocity, s.measured});
+  f("state", v);
+  if (!f.loading()) return;
   if (v.size() != 4 * servos.size())
-    r.fail(prefix + "state", "holds " + std::to_string(v.size() / 4) + " servos, this scenario has " +
-                                 std::to_string(servos.size()));
+    f.reader().fail(f.prefix() + "state", "holds " + std::to_string(v.size() / 4) + " servos, this scenario has " +
+                                              std::to_string(servos.size()));
   for (std::size_t k = 0; k < servos.size(); ++k) {
     servos[k].state->s_ref = v[4 * k];
     servos[k].state->t_ref = v[4 * k + 1];
     servos[k].state->velocity = v[4 * k + 2];
     servos[k].measured = v[4 * k + 3];
   }
+}
+
+void WallServos::save(ArchiveWriter& w, const std::string& prefix) {
+  save_fields(w, prefix, [&](CheckpointFields& f) { fields(f); });
+}
+
+void WallServos::load(const ArchiveReader& r, const std::string& prefix) {
+  load_fields(r, prefix, [&](CheckpointFields& f) { fields(f); });
 }
 
 }  // namespace domel::platform

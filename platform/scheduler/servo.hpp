@@ -28,6 +28,7 @@ class Subdomain;
 class RunRanks;
 class ArchiveWriter;
 class ArchiveReader;
+class CheckpointFields;
 
 struct WallServo {
   std::string name;        ///< the wall's name (probes.csv columns)
@@ -65,6 +66,8 @@ class WallServos final : public Component, public ProbeSource {
 
   void save(ArchiveWriter& w, const std::string& prefix) override;
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load (core/archive.hpp).
+  void fields(CheckpointFields& f);
 };
 
 }  // namespace domel::platform

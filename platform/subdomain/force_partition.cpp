@@ -233,45 +233,47 @@ std::size_t ForcePartition::bytes() const {
 
 namespace domel::platform {
 
-void ForcePartition::save(ArchiveWriter& w, const std::string& p) const {
-  w.put_scalar<std::uint64_t>(p + "threads", threads_.size());
+void ForcePartition::fields(CheckpointFields& f) {
+  const bool load = f.loading();
+  std::uint64_t threads = threads_.size();
+  f("threads", threads);
+  if (load && threads != threads_.size())
+    f.reader().fail(f.prefix() + "threads", "was written by a run on another thread count");
   for (int tier = 0; tier < 2; ++tier) {
-    w.put(p + "split" + std::to_string(tier),
-          std::vector<std::uint64_t>(split_[tier].begin(), split_[tier].end()));
+    std::vector<std::uint64_t> v(split_[tier].begin(), split_[tier].end());
+    f("split" + std::to_string(tier), v);
+    split_[tier].assign(v.begin(), v.end());
   }
-  w.put_scalar<std::uint64_t>(p + "split_builds", split_builds_);
+  f("split_builds", split_builds_);
   std::vector<std::uint64_t> spans;
   for (const ThreadForces& tf : threads_)
     for (const auto& tier : tf.span) spans.insert(spans.end(), {tier[0], tier[1]});
-  w.put(p + "spans", spans);
+  f("spans", spans);
   std::vector<std::uint32_t> wall_particle;
   std::vector<double> wall_cost;
   for (const auto& [k, c] : wall_work_) {
     wall_particle.push_back(k);
     wall_cost.push_back(c);
   }
-  w.put(p + "wall_particle", wall_particle);
-  w.put(p + "wall_cost", wall_cost);
-}
-
-void ForcePartition::load(const ArchiveReader& r, const std::string& p) {
-  if (r.scalar<std::uint64_t>(p + "threads") != threads_.size())
-    r.fail(p + "threads", "was written by a run on another thread count");
-  for (int tier = 0; tier < 2; ++tier) {
-    const auto v = r.get<std::uint64_t>(p + "split" + std::to_string(tier));
-    split_[tier].assign(v.begin(), v.end());
-  }
-  split_builds_ = r.scalar<std::uint64_t>(p + "split_builds");
-  const auto spans = r.get<std::uint64_t>(p + "spans");
-  if (spans.size() != 4 * threads_.size()) r.fail(p + "spans", "does not hold 4 values per thread");
+  f("wall_particle", wall_particle);
+  f("wall_cost", wall_cost);
+  if (!load) return;
+  if (spans.size() != 4 * threads_.size()) f.reader().fail(f.prefix() + "spans", "does not hold 4 values per thread");
   for (std::size_t t = 0; t < threads_.size(); ++t)
     for (int tier = 0; tier < 2; ++tier)
       for (int e = 0; e < 2; ++e) threads_[t].span[tier][e] = spans[4 * t + 2 * tier + e];
-  const auto wall_particle = r.get<std::uint32_t>(p + "wall_particle");
-  const auto wall_cost = r.get<double>(p + "wall_cost");
-  if (wall_particle.size() != wall_cost.size()) r.fail(p + "wall_cost", "disagrees with wall_particle in length");
+  if (wall_particle.size() != wall_cost.size())
+    f.reader().fail(f.prefix() + "wall_cost", "disagrees with wall_particle in length");
   wall_work_.clear();
   for (std::size_t e = 0; e < wall_particle.size(); ++e) wall_work_.emplace_back(wall_particle[e], wall_cost[e]);
+}
+
+void ForcePartition::save(ArchiveWriter& w, const std::string& p) const {
+  save_fields(w, p, [&](CheckpointFields& f) { const_cast<ForcePartition*>(this)->fields(f); });
+}
+
+void ForcePartition::load(const ArchiveReader& r, const std::string& p) {
+  load_fields(r, p, [&](CheckpointFields& f) { fields(f); });
 }
 
 }  // namespace domel::platform

@@ -92,6 +92,8 @@ class ForcePartition {
   /// arrays are scratch, cleared before each use.
   void save(ArchiveWriter& w, const std::string& prefix) const;
   void load(const ArchiveReader& r, const std::string& prefix);
+  /// Both directions of save and load, field by field (core/archive.hpp).
+  void fields(CheckpointFields& f);
 
   /// Bytes of the private force arrays.
   std::size_t bytes() const;

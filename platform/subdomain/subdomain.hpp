@@ -39,6 +39,7 @@ namespace domel::platform {
 
 class ArchiveWriter;
 class ArchiveReader;
+struct SubdomainSavedState;  ///< subdomain_checkpoint.cpp
 
 class Subdomain {
  public:
@@ -225,7 +226,8 @@ class Subdomain {
   /// The checkpoint part under prefix into this subdomain (store, lists,
   /// clocks); returns the part's own particle count (a rank's part: its
   /// owned ones; one process: all).
-  std::size_t load_state(const ArchiveReader& r, const std::string& prefix);
+  /// `saved`: where its state section is read to, or null.
+  std::size_t load_state(const ArchiveReader& r, const std::string& prefix, SubdomainSavedState* saved = nullptr);
   /// synchronize() for the const observers (store(), stats(),
   /// contact_records()): the pending kick is an internal deferral, not
   /// observable state.

@@ -15,56 +15,96 @@
 
 namespace domel::platform {
 
+/// What a subdomain's "state/" section holds beside its parts (particles,
+/// lists, walls, split, exchange): one list of fields for both directions.
+struct SubdomainSavedState {
+  double time = 0, dt = 0, coarse_grain = 0, skin = 0, max_overlap_ratio = 0, wall_time = 0, forces_time = 0;
+  std::uint64_t steps = 0, contacts = 0, wall_contacts = 0, builds_since_reorder = 0, reordered_size = 0;
+  bool far_active = false, walls_force_rebuild = false;
+  bool ranked = false;  ///< a part of a subdomain spread over ranks
+  std::uint64_t rank = 0, ranks = 1, owned = 0, ghosts_end = 0;
+  bool edited = false;
+  std::uint64_t walls = 0;
+  std::vector<std::uint64_t> thread_pair_contacts;
+
+  void fields(CheckpointFields& f) {
+    f("time", time);
+    f("dt", dt);
+    f("coarse_grain", coarse_grain);
+    f("skin", skin);
+    f("max_overlap_ratio", max_overlap_ratio);
+    f("wall_time", wall_time);
+    f("forces_time", forces_time);
+    f("steps", steps);
+    f("contacts", contacts);
+    f("wall_contacts", wall_contacts);
+    f("builds_since_reorder", builds_since_reorder);
+    f("reordered_size", reordered_size);
+    f("far_active", far_active);
+    f("walls_force_rebuild", walls_force_rebuild);
+    f("ranked", ranked);
+    if (ranked) {
+      f("rank", rank);
+      f("ranks", ranks);
+      f("owned", owned);
+      f("ghosts_end", ghosts_end);
+      f("edited", edited);
+    }
+    f("walls", walls);
+    f("thread_pair_contacts", thread_pair_contacts);
+  }
+};
+
 void Subdomain::save(ArchiveWriter& w, const std::string& p) {
   store();  // finishes the last step and counts the contacts
   if (ranks_ && edited_)
     throw RuntimeError("subdomain '" + name_ + "': a checkpoint between an edit of the particles and the next step "
                        "(the ghosts are dropped, the lists name them) cannot be written");
+  SubdomainSavedState st{time_, dt_, coarse_grain_, skin_, last_max_overlap_ratio_, wall_time_, forces_time_,
+                steps_, last_contacts_, last_wall_contacts_, builds_since_reorder_, reordered_size_,
+                far_active_, walls_force_rebuild_};
   if (ranks_) {
     // this rank's part: its own particles, then its ghosts, and who holds which ghosts
-    w.put(p + "rank", std::vector<std::uint64_t>{static_cast<std::uint64_t>(ranks_->rank()),
-                                                 static_cast<std::uint64_t>(ranks_->size()), owned_, ghosts_end_,
-                                                 edited_ ? 1u : 0u});
+    st.ranked = true;
+    st.rank = static_cast<std::uint64_t>(ranks_->rank());
+    st.ranks = static_cast<std::uint64_t>(ranks_->size());
+    st.owned = owned_;
+    st.ghosts_end = ghosts_end_;
+    st.edited = edited_;
     ranks_->save(w, p + "exchange/");
   }
+  st.walls = wall_lists_.size();
+  for (const auto& ts : scratch_) st.thread_pair_contacts.push_back(ts.pair_contacts);
+  save_fields(w, p + "state/", [&](CheckpointFields& f) { st.fields(f); });
   store_.save(w, p + "particles/");
   nlist_.save(w, p + "pairs/");
-  w.put_scalar<std::uint64_t>(p + "walls", wall_lists_.size());
   for (std::size_t k = 0; k < wall_lists_.size(); ++k) wall_lists_[k].save(w, p + "wall" + std::to_string(k) + "/");
   partition_.save(w, p + "split/");
-  std::vector<std::uint64_t> pair_contacts;
-  for (const auto& ts : scratch_) pair_contacts.push_back(ts.pair_contacts);
-  w.put(p + "thread_pair_contacts", pair_contacts);
-  w.put(p + "reals", std::vector<double>{time_, dt_, coarse_grain_, skin_, last_max_overlap_ratio_, wall_time_,
-                                         forces_time_});
-  w.put(p + "counters", std::vector<std::uint64_t>{steps_, last_contacts_, last_wall_contacts_, builds_since_reorder_,
-                                                   reordered_size_, far_active_ ? 1u : 0u,
-                                                   walls_force_rebuild_ ? 1u : 0u});
 }
 
 bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
-  if (r.has(p + "rank") != (ranks_ != nullptr))
-    r.fail(p + "rank", ranks_ ? "holds a subdomain of one process; this run is spread over ranks"
-                              : "holds a subdomain spread over ranks; this run is one process");
-  const std::size_t own = load_state(r, p);
+  SubdomainSavedState st;
+  const std::size_t own = load_state(r, p, &st);
+  if (st.ranked != (ranks_ != nullptr))
+    r.fail(p + "state/ranked", ranks_ ? "holds a subdomain of one process; this run is spread over ranks"
+                                      : "holds a subdomain spread over ranks; this run is one process");
   if (ranks_) {
-    const auto rank = r.get<std::uint64_t>(p + "rank");
-    if (rank[0] != static_cast<std::uint64_t>(ranks_->rank()) || rank[1] != static_cast<std::uint64_t>(ranks_->size()))
-      r.fail(p + "rank", "is rank " + std::to_string(rank[0]) + " of " + std::to_string(rank[1]) + ", not rank " +
-                             std::to_string(ranks_->rank()) + " of " + std::to_string(ranks_->size()));
+    if (st.rank != static_cast<std::uint64_t>(ranks_->rank()) || st.ranks != static_cast<std::uint64_t>(ranks_->size()))
+      r.fail(p + "state/rank", "is rank " + std::to_string(st.rank) + " of " + std::to_string(st.ranks) +
+                                   ", not rank " + std::to_string(ranks_->rank()) + " of " +
+                                   std::to_string(ranks_->size()));
     owned_ = own;
-    ghosts_end_ = rank[3];
-    edited_ = rank[4] != 0;
+    ghosts_end_ = st.ghosts_end;
+    edited_ = st.edited;
     if (owned_ > ghosts_end_ || ghosts_end_ != store_.size())
-      r.fail(p + "rank", "does not count the part's own particles and ghosts");
+      r.fail(p + "state/ghosts_end", "does not count the part's own particles and ghosts");
     ranks_->load(r, p + "exchange/");
     if (ranks_->ghosts_begin() != owned_ || ranks_->ghosts_end() != ghosts_end_)
       r.fail(p + "exchange/ghosts/first", "does not place the ghosts after the rank's own particles");
   }
-  const auto pair_contacts = r.get<std::uint64_t>(p + "thread_pair_contacts");
-  if (pair_contacts.size() != scratch_.size()) return false;  // the split is rebuilt at the next evaluation
+  if (st.thread_pair_contacts.size() != scratch_.size()) return false;  // the split is rebuilt at the next evaluation
   partition_.load(r, p + "split/");
-  for (std::size_t t = 0; t < scratch_.size(); ++t) scratch_[t].pair_contacts = pair_contacts[t];
+  for (std::size_t t = 0; t < scratch_.size(); ++t) scratch_[t].pair_contacts = st.thread_pair_contacts[t];
   return true;
 }
 
@@ -124,36 +164,30 @@ void Subdomain::restore_shared_out(const std::vector<std::pair<const ArchiveRead
   contacts_collected_ = false;
 }
 
-std::size_t Subdomain::load_state(const ArchiveReader& r, const std::string& p) {
+std::size_t Subdomain::load_state(const ArchiveReader& r, const std::string& p, SubdomainSavedState* saved) {
   synchronize();
-  const auto reals = r.get<double>(p + "reals");
-  const auto counters = r.get<std::uint64_t>(p + "counters");
-  if (reals.size() != 7) r.fail(p + "reals", "holds " + std::to_string(reals.size()) + " values, expected 7");
-  if (counters.size() != 7) r.fail(p + "counters", "holds " + std::to_string(counters.size()) + " values, expected 7");
-  if (reals[1] != dt_)
-    r.fail(p + "reals", "was written with a time step of " + std::to_string(reals[1]) + " s; subdomain '" + name_ +
-                            "' now steps " + std::to_string(dt_) + " s");
-  if (reals[2] != coarse_grain_)
-    r.fail(p + "reals", "was written with coarse_grain " + std::to_string(reals[2]) + "; subdomain '" + name_ +
-                            "' now has " + std::to_string(coarse_grain_));
-  if (reals[3] != skin_) r.fail(p + "reals", "was written with another neighbour-list skin");
-  std::size_t own = SIZE_MAX;
-  if (r.has(p + "rank")) {
-    const auto rank = r.get<std::uint64_t>(p + "rank");
-    if (rank.size() != 5) r.fail(p + "rank", "holds " + std::to_string(rank.size()) + " values, expected 5");
-    own = rank[2];
-  }
+  SubdomainSavedState local;
+  SubdomainSavedState& st = saved ? *saved : local;
+  load_fields(r, p + "state/", [&](CheckpointFields& f) { st.fields(f); });
+  if (st.dt != dt_)
+    r.fail(p + "state/dt", "was written with a time step of " + std::to_string(st.dt) + " s; subdomain '" + name_ +
+                               "' now steps " + std::to_string(dt_) + " s");
+  if (st.coarse_grain != coarse_grain_)
+    r.fail(p + "state/coarse_grain", "was written with coarse_grain " + std::to_string(st.coarse_grain) +
+                                         "; subdomain '" + name_ + "' now has " + std::to_string(coarse_grain_));
+  if (st.skin != skin_) r.fail(p + "state/skin", "was written with another neighbour-list skin");
+  std::size_t own = st.ranked ? static_cast<std::size_t>(st.owned) : SIZE_MAX;
   nlist_.configure(skin_, pipeline_->history_stride());
   store_.load(r, p + "particles/");
   if (own == SIZE_MAX) own = store_.size();
-  if (own > store_.size()) r.fail(p + "rank", "counts more particles than the part holds");
+  if (own > store_.size()) r.fail(p + "state/owned", "counts more particles than the part holds");
   nlist_.load(r, p + "pairs/");
   const std::size_t n = store_.size();
   for (std::size_t e = 0; e < nlist_.size(); ++e)
     if (nlist_.i[e] >= n || nlist_.j[e] >= n) r.fail(p + "pairs/i", "names a particle beyond the store");
-  if (r.scalar<std::uint64_t>(p + "walls") != wall_lists_.size())
-    r.fail(p + "walls", "holds " + std::to_string(r.scalar<std::uint64_t>(p + "walls")) + " walls; the scenario has " +
-                            std::to_string(wall_lists_.size()));
+  if (st.walls != wall_lists_.size())
+    r.fail(p + "state/walls", "holds " + std::to_string(st.walls) + " walls; the scenario has " +
+                                  std::to_string(wall_lists_.size()));
   for (std::size_t k = 0; k < wall_lists_.size(); ++k) {
     const std::string wp = p + "wall" + std::to_string(k) + "/";
     wall_lists_[k].load(r, wp);
@@ -162,17 +196,17 @@ std::size_t Subdomain::load_state(const ArchiveReader& r, const std::string& p) 
     if (wall_lists_[k].history.size() != wall_lists_[k].particle.size() * pipeline_->history_stride())
       r.fail(wp + "history", "does not hold this contact model's history per candidate");
   }
-  time_ = reals[0];
-  last_max_overlap_ratio_ = reals[4];
-  wall_time_ = reals[5];
-  forces_time_ = reals[6];
-  steps_ = counters[0];
-  last_contacts_ = counters[1];
-  last_wall_contacts_ = counters[2];
-  builds_since_reorder_ = counters[3];
-  reordered_size_ = counters[4];
-  far_active_ = counters[5] != 0;
-  walls_force_rebuild_ = counters[6] != 0;
+  time_ = st.time;
+  last_max_overlap_ratio_ = st.max_overlap_ratio;
+  wall_time_ = st.wall_time;
+  forces_time_ = st.forces_time;
+  steps_ = st.steps;
+  last_contacts_ = static_cast<std::size_t>(st.contacts);
+  last_wall_contacts_ = static_cast<std::size_t>(st.wall_contacts);
+  builds_since_reorder_ = static_cast<std::size_t>(st.builds_since_reorder);
+  reordered_size_ = static_cast<std::size_t>(st.reordered_size);
+  far_active_ = st.far_active;
+  walls_force_rebuild_ = st.walls_force_rebuild;
   for (std::size_t w = 0; w < walls_now_.size(); ++w)
     if (walls_now_[w].moving) walls_now_[w].place((*walls_)[w], wall_time_);
   if (gravity_) gravity_->at(time_, body_forces_.gravity);  // the loaded forces' time

@@ -51,16 +51,23 @@ class TallyOutput final : public dp::Component {
   }
   void finish(dp::RunContext&, json& summary) override { summary["outputs"]["test_tally"] = "tally.txt"; }
   void save(dp::ArchiveWriter& w, const std::string& p) override {
-    w.put(p + "state", std::vector<std::uint64_t>{lines_.index(), fs::file_size(path_)});
+    dp::save_fields(w, p, [&](dp::CheckpointFields& f) { fields(f); });
   }
   void load(dp::RunContext&, const dp::ArchiveReader& r, const std::string& p) override {
-    const auto v = r.get<std::uint64_t>(p + "state");
-    if (v.size() != 2) r.fail(p + "state", "does not hold the tally's state");
-    lines_.resume(v[0]);
-    fs::resize_file(path_, v[1]);
+    dp::load_fields(r, p, [&](dp::CheckpointFields& f) { fields(f); });
   }
 
  private:
+  /// Both directions of the checkpoint: the cadence's index and how far the file got.
+  void fields(dp::CheckpointFields& f) {
+    std::uint64_t index = lines_.index(), bytes = f.loading() ? 0 : fs::file_size(path_);
+    f("index", index);
+    f("bytes", bytes);
+    if (!f.loading()) return;
+    lines_.resume(index);
+    fs::resize_file(path_, bytes);
+  }
+
   double interval_;
   dp::Cadence lines_;
   fs::path path_;
@@ -134,7 +141,7 @@ TEST(OutputKind, ARegisteredOutputIsValidatedWrittenCheckpointedAndResumed) {
   const dp::RunResult first = run(with, resumed, 555);
   ASSERT_EQ(first.macro_steps, 555u);
   const dp::ArchiveReader ck(resumed / dp::kCheckpointFile);
-  EXPECT_TRUE(ck.has("test_tally/state"));
+  EXPECT_TRUE(ck.has("test_tally/bytes"));
   EXPECT_NE(slurp(resumed / "tally.txt"), lines);
   run(with, resumed, 0, resumed / dp::kCheckpointFile);
   EXPECT_EQ(slurp(resumed / "tally.txt"), lines);
