@@ -349,6 +349,13 @@ void ModelInstance::contact(domel_contact_batch_v2& batch) const {
   if (model_->contact.contact(handle_, &batch, err, sizeof err) != DOMEL_OK) fail("contact kernel", err);
 }
 
+bool ModelInstance::control_setup(const domel_control_setup_v1& setup) const {
+  if (model_->controller.setup == nullptr) return false;
+  char err[1024] = {0};
+  if (model_->controller.setup(handle_, &setup, err, sizeof err) != DOMEL_OK) fail("setup", err);
+  return true;
+}
+
 void ModelInstance::control(domel_control_step_v1& step) const {
   if (model_->controller.control == nullptr)
     throw PluginError(host_->prefix + ": is not a controller (it has no 'control' callback)");

@@ -122,6 +122,10 @@ class ModelInstance {
   /// for every particle is refused (PluginError).
   void insert(const domel_insert_request_v1& request, std::vector<double>& x, std::vector<double>& y,
               std::vector<double>& z, std::vector<double>& r, std::vector<uint32_t>* component = nullptr) const;
+  /// Hand a controller its coupling's derived values (ABI 2.5's optional
+  /// setup; false: the model takes none). A refusal throws PluginError with
+  /// the model's message.
+  bool control_setup(const domel_control_setup_v1& setup) const;
   /// Run a controller on one control interval.
   void control(domel_control_step_v1& step) const;
   /// Run a fluid coupler's exchange of one coupling interval.

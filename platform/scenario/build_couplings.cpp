@@ -371,101 +371,75 @@ void build_couplings(Build& b) {
     const int tmax = cj["transfer_max_steps"].get<int>();
     s.transfer_controls = std::max<std::uint64_t>(1, (tmax + s.fine_steps - 1) / s.fine_steps);
     const double dt_f = macro / n_f, dt_c = macro / n_c;
-    const std::size_t n_cells = static_cast<std::size_t>(s.grid.cells[0]) * s.grid.cells[1] * s.grid.cells[2];
-    std::size_t block_before = b.ck.diags.size();
-    auto controller = [&](const char* key, ControllerSetup& setup, json params) {
+    // What the controllers are set up for (ABI 2.5): the levels' steps per
+    // control interval and time steps, the grid, and the inflow cells (those
+    // touching an inflow face, each with its inward normal), from which the
+    // models take their defaults.
+    std::vector<uint32_t> inflow_cells;
+    std::vector<int32_t> inflow_dirs;
+    for (int iz = 0; iz < s.grid.cells[2]; ++iz)
+      for (int iy = 0; iy < s.grid.cells[1]; ++iy)
+        for (int ix = 0; ix < s.grid.cells[0]; ++ix) {
+          const int i3[3] = {ix, iy, iz};
+          int32_t dir[3] = {0, 0, 0};
+          bool touches = false;
+          for (int face = 0; face < kFaces; ++face) {
+            const int a = face / 2;
+            const bool at = face % 2 == 0 ? i3[a] == 0 : i3[a] == s.grid.cells[a] - 1;
+            if (!s.inflow[face] || !at) continue;
+            touches = true;
+            dir[a] += face % 2 == 0 ? 1 : -1;  // inward: away from the face
+          }
+          if (!touches) continue;
+          inflow_cells.push_back(static_cast<uint32_t>(ix + s.grid.cells[0] * (iy + s.grid.cells[1] * iz)));
+          inflow_dirs.insert(inflow_dirs.end(), dir, dir + 3);
+        }
+    const domel_control_level_setup_v1 level_setup[2] = {
+        {sizeof(domel_control_level_setup_v1), 0, sim.subdomains[s.fine]->name().c_str(),
+         sim.subdomains[s.fine]->coarse_grain(), dt_f, static_cast<uint64_t>(s.fine_steps)},
+        {sizeof(domel_control_level_setup_v1), 0, sim.subdomains[s.coarse]->name().c_str(),
+         sim.subdomains[s.coarse]->coarse_grain(), dt_c, static_cast<uint64_t>(s.coarse_steps)}};
+    domel_control_setup_v1 setup_view{};
+    setup_view.struct_size = sizeof setup_view;
+    setup_view.level_count = 2;
+    setup_view.interval = static_cast<double>(control_macro) * macro;
+    setup_view.levels = level_setup;
+    setup_view.nx = static_cast<uint32_t>(s.grid.cells[0]);
+    setup_view.ny = static_cast<uint32_t>(s.grid.cells[1]);
+    setup_view.nz = static_cast<uint32_t>(s.grid.cells[2]);
+    setup_view.n_cells = static_cast<std::size_t>(s.grid.cells[0]) * s.grid.cells[1] * s.grid.cells[2];
+    for (int a = 0; a < 3; ++a) {
+      setup_view.origin[a] = s.grid.lo[a];
+      setup_view.spacing[a] = (s.grid.hi[a] - s.grid.lo[a]) / s.grid.cells[a];
+    }
+    setup_view.n_inflow_cells = inflow_cells.size();
+    setup_view.inflow_cell = inflow_cells.data();
+    setup_view.inflow_direction = inflow_dirs.data();
+    // A controller block is the model's own (validated against its schema,
+    // its defaults filled, by check_models): the block less "enabled" and
+    // "model" is what the model is created with.
+    auto controller = [&](const char* key, ControllerSetup& setup) {
       const json& blk = cj[key];
       setup.enabled = blk["enabled"].get<bool>();
       if (!setup.enabled) return;
       const std::string model = blk["model"].get<std::string>();
       const RegisteredModel* m = b.registry.find(DOMEL_KIND_CONTROLLER, model);
-      if (m == nullptr) {
-        b.ck.add(base + "/" + key + "/model", "unknown controller model '" + model + "'",
-                 suggest(model, b.registry.names(DOMEL_KIND_CONTROLLER)));
+      if (m == nullptr) {  // check_models reported it
         setup.enabled = false;
         return;
       }
-      if (b.ck.diags.size() > block_before) {  // the block's own problems are reported; the model is not asked
-        setup.enabled = false;
-        return;
-      }
-      for (const auto& c : params["cells"])
-        if (c.get<std::size_t>() >= n_cells)
-          b.ck.add(base + "/" + key + "/cells", "expected cell indices below " + std::to_string(n_cells) +
-                                                    " (the region's cells), found " + std::to_string(c.get<std::size_t>()));
+      const json params = plugin_params(blk, DOMEL_KIND_CONTROLLER);
       try {
         setup.model = std::make_shared<ModelInstance>(*m, params, base + "/" + key);
+        setup.model->control_setup(setup_view);
         setup.params = params;
       } catch (const PluginError& e) {
         b.ck.add(base + "/" + key, e.what());
         setup.enabled = false;
       }
     };
-    // stress control: default cells touch an inflow face; direction: the inward normals
-    {
-      block_before = b.ck.diags.size();
-      const json& blk = cj["stress_control"];
-      json cells = json::array(), dirs = json::array();
-      if (blk.contains("cells")) {
-        cells = blk["cells"];
-        if (blk.contains("directions")) dirs = blk["directions"];
-        if (dirs.size() != cells.size())
-          b.ck.add(base + "/stress_control/directions",
-                   "expected one direction per controlled cell (" + std::to_string(cells.size()) + "), found " +
-                       std::to_string(dirs.size()));
-      } else {
-        for (int iz = 0; iz < s.grid.cells[2]; ++iz)
-          for (int iy = 0; iy < s.grid.cells[1]; ++iy)
-            for (int ix = 0; ix < s.grid.cells[0]; ++ix) {
-              const int i3[3] = {ix, iy, iz};
-              int dir[3] = {0, 0, 0};
-              bool touches = false;
-              for (int face = 0; face < kFaces; ++face) {
-                const int a = face / 2;
-                const bool at = face % 2 == 0 ? i3[a] == 0 : i3[a] == s.grid.cells[a] - 1;
-                if (!s.inflow[face] || !at) continue;
-                touches = true;
-                dir[a] += face % 2 == 0 ? 1 : -1;  // inward: away from the face
-              }
-              if (!touches) continue;
-              cells.push_back(ix + s.grid.cells[0] * (iy + s.grid.cells[1] * iz));
-              dirs.push_back({dir[0], dir[1], dir[2]});
-            }
-      }
-      for (std::size_t k = 0; k < dirs.size(); ++k)
-        for (int a = 0; a < 3; ++a) {
-          const double v = dirs[k][a].get<double>();
-          if (v != -1 && v != 0 && v != 1)
-            b.ck.add(base + "/stress_control/directions/" + std::to_string(k) + "/" + std::to_string(a),
-                     "expected -1, 0 or 1, found " + fmt_num(v));
-        }
-      json p = {{"cells", cells},
-                {"directions", dirs},
-                {"kp", blk.contains("kp") ? blk["kp"].get<double>() : 1.0 / s.fine_steps},
-                {"ki", blk.contains("ki") ? blk["ki"].get<double>() : 1.0 / (s.fine_steps * dt_f)},
-                {"layer_diameters", blk["layer_diameters"]},
-                {"fade_fraction", blk["fade_fraction"]},
-                {"velocity_limit", blk["velocity_limit"]},
-                // one fine step ahead: the reference's per-step prediction, without the contact force the view lacks
-                {"limit_horizon", dt_f}};
-      controller("stress_control", s.stress, p);
-    }
-    {
-      block_before = b.ck.diags.size();
-      const json& blk = cj["velocity_control"];
-      json cells = json::array();
-      if (blk.contains("cells")) cells = blk["cells"];
-      else
-        for (std::size_t k = 0; k < n_cells; ++k) cells.push_back(k);
-      json p = {{"cells", cells},
-                {"kp", blk.contains("kp") ? blk["kp"].get<double>() : 1.0 / s.coarse_steps},
-                {"ki", blk["ki"]},
-                {"time_step", dt_c},
-                {"mass_flow_correction", json::array()},
-                {"velocity_limit", blk["velocity_limit"]}};
-      for (std::size_t k = 0; k < cells.size(); ++k) p["mass_flow_correction"].push_back(blk["mass_flow_correction"]);
-      controller("velocity_control", s.velocity, p);
-    }
+    controller("stress_control", s.stress);
+    controller("velocity_control", s.velocity);
     sim.subdomains[s.fine]->store().enable_external_force();
     sim.subdomains[s.coarse]->store().enable_external_force();
     sim.couplings.push_back(std::make_unique<Coupling>(std::move(s)));

@@ -40,6 +40,8 @@ json platform_block_properties(uint32_t kind) {
   const json& defs = platform_scenario_schema()["$defs"];
   if (kind == DOMEL_KIND_INSERTION) return defs["insertion_model"]["properties"];
   if (kind == DOMEL_KIND_FLUID_COUPLER) return defs["fluid_model"]["properties"];
+  if (kind == DOMEL_KIND_CONTROLLER)  // a controller block's own key beside the model's parameters
+    return json{{"enabled", defs["coupling"]["properties"]["velocity_control"]["properties"]["enabled"]}};
   return json::object();
 }
 
@@ -238,6 +240,12 @@ void check_models(Checker& ck, json& doc, const PluginRegistry& registry, const 
       if (json* rolling = member_mut((*its)[q], "rolling"))
         check_model_block(ck, registry, *rolling, idx("/interactions", q) + "/rolling", DOMEL_KIND_ROLLING, true,
                           filled);
+  if (json* cs = member_mut(doc, "couplings"); cs && cs->is_array())
+    for (std::size_t q = 0; q < cs->size(); ++q)
+      for (const char* key : {"stress_control", "velocity_control"})
+        if (json* block = member_mut((*cs)[q], key))
+          check_model_block(ck, registry, *block, idx("/couplings", q) + "/" + key, DOMEL_KIND_CONTROLLER, false,
+                            filled);
   json* sds = member_mut(doc, "subdomains");
   if (!sds || !sds->is_array()) return;
   for (std::size_t k = 0; k < sds->size(); ++k) {

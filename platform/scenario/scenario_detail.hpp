@@ -80,6 +80,7 @@ inline int axis_index(const json* j) {
 inline std::vector<std::string> platform_keys(uint32_t kind) {
   if (kind == DOMEL_KIND_INSERTION) return {"model", "region", "seed", "velocity", "fixed", "material"};
   if (kind == DOMEL_KIND_FLUID_COUPLER) return {"model", "subdomains", "interval", "write_interval"};
+  if (kind == DOMEL_KIND_CONTROLLER) return {"model", "enabled"};
   return {"model"};
 }
 

@@ -106,6 +106,40 @@ inline LevelPair fine_and_coarse(const domel_control_step_v1& step, const char* 
   return p;
 }
 
+/// The two levels of a setup (ABI 2.5), checked as fine_and_coarse checks a
+/// step: exactly two levels, levels[0] fine and levels[1] coarse, each with
+/// a finite time step > 0 and at least one step per control interval, and a
+/// grid of at least one cell. Refuses with sdk::ParameterError.
+struct SetupLevels {
+  const domel_control_level_setup_v1* fine;
+  const domel_control_level_setup_v1* coarse;
+};
+inline SetupLevels checked_setup(const domel_control_setup_v1& s, const char* model) {
+  const std::string who = std::string(model) + ": ";
+  if (s.level_count != 2 || s.levels == nullptr)
+    throw sdk::ParameterError(who + "needs exactly 2 levels (levels[0] the fine level, levels[1] the coarse level), got " +
+                              std::to_string(s.level_count));
+  for (int i = 0; i < 2; ++i) {
+    const domel_control_level_setup_v1& l = s.levels[i];
+    if (!std::isfinite(l.time_step) || !(l.time_step > 0.0) || l.steps_per_interval == 0)
+      throw sdk::ParameterError(who + "levels[" + std::to_string(i) + "] ('" + (l.name ? l.name : "?") +
+                                "') needs a time step > 0 and at least one step per control interval");
+  }
+  if (s.n_cells == 0) throw sdk::ParameterError(who + "the coupling's grid has no cell");
+  return {&s.levels[0], &s.levels[1]};
+}
+
+/// Refuses (sdk::ParameterError) a listed cell index beyond the grid of a setup.
+inline void check_cells_in_setup(const std::vector<uint32_t>& cells, const domel_control_setup_v1& s,
+                                 const char* model) {
+  for (std::size_t a = 0; a < cells.size(); ++a)
+    if (cells[a] >= s.n_cells)
+      throw sdk::ParameterError(std::string(model) + ": cells[" + std::to_string(a) + "] = " +
+                                std::to_string(cells[a]) + " lies outside the coupling's grid (" +
+                                std::to_string(s.nx) + " x " + std::to_string(s.ny) + " x " + std::to_string(s.nz) +
+                                " = " + std::to_string(s.n_cells) + " cells; index ix + nx (iy + ny iz))");
+}
+
 /// The particles of a level the controller writes to, after checking that
 /// every array it reads or writes is there.
 inline domel_particles_v1& checked_particles(domel_level_v1& l, int index, const char* model) {
@@ -218,13 +252,12 @@ inline double non_negative(const nlohmann::json& j, const char* key, const char*
   return v;
 }
 
-/// The required list `cells`: distinct grid-cell indices (integers >= 0).
+/// The list `cells`: distinct grid-cell indices (integers >= 0); empty
+/// when absent (the model then takes its default from the setup).
 inline std::vector<uint32_t> parse_cells(const nlohmann::json& j, const char* model) {
   const std::string who = std::string(model) + ": ";
   const auto it = j.find("cells");
-  if (it == j.end())
-    throw sdk::ParameterError(who +
-                              "missing required 'cells' (the indices ix + nx (iy + ny iz) of the cells to control)");
+  if (it == j.end()) return {};
   if (!it->is_array() || it->empty())
     throw sdk::ParameterError(who + "'cells' must be a non-empty array of cell indices");
   std::vector<uint32_t> cells;

@@ -23,7 +23,7 @@
 //   F = dir_k u_k on each fine particle of c in the forcing layer (full over
 //   the outer 1 - fade_fraction of it, sin^2 ramp to 0 over the inner part),
 //   scaled per particle by the velocity limiter (common.hpp), which predicts
-//   v + h F/m over the horizon h (limit_horizon, default T)
+//   v + h F/m over the horizon h (limit_horizon, default one fine step)
 //   mean applied |F| per controlled particle < u_k/2: undo the integration
 // Units: PV, SP, e, u in N (a mean normal force per particle), I in N s.
 #pragma once
@@ -71,7 +71,7 @@ class StressPi {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_CONTROLLER;
   static constexpr const char* kName = "stress_pi";
-  static constexpr const char* kVersion = "1.1.0";
+  static constexpr const char* kVersion = "2.0.0";
   static constexpr const char* kSummary =
       "PI stress controller on the fine region's boundary cells: pushes levels[0] (FINE) particles so their normal "
       "stress matches levels[1] (COARSE) in the congruent cell (grids of both levels must match)";
@@ -80,33 +80,36 @@ class StressPi {
   "description": "Fine-boundary stress controller after LIGGGHTS-PFM fix forcecontrol/region, ctrlPV stress (docs/controllers.md). levels[0] is the fine level, which is pushed; levels[1] the coarse level, which sets the target; both grids must have the same geometry. Each control interval it compares the mean normal force per particle from the normal stress of each controlled fine cell with the coarse level's in the congruent cell, and pushes the fine particles in a layer against one face of the cell.",
   "properties": {
     "cells": { "type": "array", "minItems": 1, "items": { "type": "integer", "minimum": 0, "maximum": 4294967294 },
-               "description": "indices ix + nx (iy + ny iz) of the cells to control (the active boundary cells), each listed once" },
+               "description": "indices ix + nx (iy + ny iz) of the cells to control (the active boundary cells), each listed once, with directions (default: the coupling's inflow cells, those touching a face where material enters the fine level)" },
     "directions": { "type": "array", "minItems": 1,
                     "items": { "type": "array", "minItems": 3, "maxItems": 3, "items": { "type": "integer", "enum": [-1, 0, 1] } },
-                    "description": "one per entry of cells: the direction [x, y, z] the force pushes in, components -1, 0 or 1 (e.g. [0, 0, -1] for a cell under a top inflow face); components 0 are not controlled" },
+                    "description": "one per entry of cells, given with cells: the direction [x, y, z] the force pushes in, components -1, 0 or 1 (e.g. [0, 0, -1] for a cell under a top inflow face); components 0 are not controlled (default: the inward normal of the inflow face(s) each inflow cell touches)" },
     "kp": { "type": "number", "minimum": 0, "x-unit": "1",
-            "description": "proportional gain k_p (the reference uses 1/N for a control interval of N fine steps)" },
+            "description": "proportional gain k_p (default 1/N for a control interval of N fine steps, as the reference's examples)" },
     "ki": { "type": "number", "minimum": 0, "x-unit": "1/s",
-            "description": "integral gain k_i (the reference uses 1/(N dt_fine))" },
+            "description": "integral gain k_i (default 1/(N dt_fine), as the reference's examples)" },
     "kd": { "type": "number", "minimum": 0, "default": 0, "x-unit": "s",
             "description": "derivative gain k_d, on the process value, not on the error" },
     "layer_diameters": { "type": "number", "exclusiveMinimum": 0, "default": 1.4, "x-unit": "1",
-                         "description": "thickness of the forcing layer against the pushing face, in units of the fine level's largest particle diameter (1.4 in the reference code)" },
+                         "description": "thickness of the forcing layer against the pushing face, in units of the fine level's largest particle diameter (LIGGGHTS-PFM code: 1.4; its documentation: 1.3 + 0.25)" },
     "fade_fraction": { "type": "number", "minimum": 0, "maximum": 1, "default": 0.125, "x-unit": "1",
                        "description": "inner share of the forcing layer over which the force fades to zero with a sin^2 ramp" },
     "velocity_limit": { "type": "number", "minimum": 0, "default": 0.2, "x-unit": "1",
-                        "description": "relative velocity limit r: a pushed particle's velocity, predicted over the limit horizon, stays within the coarse cell's particle velocity range widened by r (0: no limit)" },
+                        "description": "relative velocity limit r: a pushed particle's velocity, predicted over the limit horizon, stays within the coarse cell's particle velocity range widened by r (LIGGGHTS-PFM velocity_limit on: 0.2; 0: no limit)" },
     "limit_horizon": { "type": "number", "exclusiveMinimum": 0, "x-unit": "s",
-                       "description": "time over which the velocity limiter predicts the force's effect, v + horizon F/m (default: the whole control interval). The reference predicts one (half) step with the contact force included; a particle pressed into a bed has its push balanced by its contacts, which this view does not carry, so a horizon of a whole interval throttles the push far below what the bed needs. domel's couplings pass the fine time step" }
+                       "description": "time over which the velocity limiter predicts the force's effect, v + horizon F/m (default: one fine time step). The reference predicts one (half) step with the contact force included; a particle pressed into a bed has its push balanced by its contacts, which this view does not carry, so a horizon of a whole control interval throttles the push far below what the bed needs" }
   },
-  "required": ["cells", "directions", "kp", "ki"],
+  "required": [],
   "additionalProperties": false
 })json";
 
   explicit StressPi(const sdk::Params& p)
-      : cells_(parse_cells(p.json(), kName)),
-        kp_(non_negative(p.json(), "kp", kName, true)),
-        ki_(non_negative(p.json(), "ki", kName, true)),
+      : host_(p.host()),
+        cells_(parse_cells(p.json(), kName)),
+        has_kp_(p.json().contains("kp")),
+        has_ki_(p.json().contains("ki")),
+        kp_(non_negative(p.json(), "kp", kName, false, 0.0)),
+        ki_(non_negative(p.json(), "ki", kName, false, 0.0)),
         kd_(non_negative(p.json(), "kd", kName, false, 0.0)),
         layer_diameters_(non_negative(p.json(), "layer_diameters", kName, false, 1.4)),
         fade_fraction_(non_negative(p.json(), "fade_fraction", kName, false, 0.125)),
@@ -117,11 +120,45 @@ class StressPi {
     if (fade_fraction_ > 1.0) throw sdk::ParameterError(who + "'fade_fraction' must lie in [0, 1]");
     if (p.json().contains("limit_horizon") && !(limit_horizon_ > 0.0))
       throw sdk::ParameterError(who + "'limit_horizon' must be > 0");
-    directions_ = parse_directions(p.json(), cells_.size());
+    if (cells_.empty() != !p.json().contains("directions"))
+      throw sdk::ParameterError(who + "give 'cells' and 'directions' together (one direction per cell), or neither "
+                                      "(the coupling's inflow cells with their inward normals)");
+    if (!cells_.empty()) directions_ = parse_directions(p.json(), cells_.size());
     state_.resize(cells_.size());
   }
 
+  /// The coupling's derived values (ABI 2.5): the defaults of kp, ki, the
+  /// limit horizon and the cells from the fine level's step and the steps
+  /// per interval, and the cells checked against the grid.
+  void setup(const domel_control_setup_v1& s) {
+    const SetupLevels lv = checked_setup(s, kName);
+    const double n = static_cast<double>(lv.fine->steps_per_interval), dt = lv.fine->time_step;
+    if (!has_kp_) kp_ = 1.0 / n;         // the reference's examples: 1/N
+    if (!has_ki_) ki_ = 1.0 / (n * dt);  // and 1/(N dt_fine)
+    if (!(limit_horizon_ > 0.0)) limit_horizon_ = dt;
+    if (cells_.empty()) {
+      if (s.n_inflow_cells == 0 || s.inflow_cell == nullptr || s.inflow_direction == nullptr)
+        throw sdk::ParameterError(std::string(kName) + ": the coupling has no inflow cell to control: give 'cells' and "
+                                                       "'directions'");
+      for (std::size_t a = 0; a < s.n_inflow_cells; ++a) {
+        cells_.push_back(s.inflow_cell[a]);
+        directions_.push_back({s.inflow_direction[3 * a], s.inflow_direction[3 * a + 1], s.inflow_direction[3 * a + 2]});
+      }
+      state_.assign(cells_.size(), StressPiCellState{});
+    }
+    check_cells_in_setup(cells_, s, kName);
+    set_up_ = true;
+    std::ostringstream m;
+    m << "kp = " << kp_ << (has_kp_ ? "" : " (1/N)") << ", ki = " << ki_ << " 1/s" << (has_ki_ ? "" : " (1/(N dt))")
+      << " with N = " << lv.fine->steps_per_interval << " steps of " << dt << " s of '" << lv.fine->name
+      << "' per control interval; " << cells_.size() << " cell(s) controlled";
+    host_.info(m.str());
+  }
+
   void control(domel_control_step_v1& step) {
+    if (!set_up_ && (!has_kp_ || !has_ki_ || cells_.empty()))
+      fail(kName, "kp, ki or cells were left to their defaults, which come from the host's setup (ABI 2.5), and "
+                  "setup was not called");
     const LevelPair lv = fine_and_coarse(step, kName);
     const domel_cell_grid_v1& ga = *lv.fine->cells;    // actual
     const domel_cell_grid_v1& gt = *lv.coarse->cells;  // target
@@ -323,11 +360,14 @@ class StressPi {
     s.unwound = {};
   }
 
+  sdk::Host host_;
   std::vector<uint32_t> cells_;
   std::vector<std::array<int, 3>> directions_;
+  bool has_kp_, has_ki_;
   double kp_, ki_, kd_;
   double layer_diameters_, fade_fraction_, velocity_limit_;
-  double limit_horizon_;  ///< 0: the control interval
+  double limit_horizon_;  ///< 0 until setup: the control interval
+  bool set_up_ = false;
   std::vector<StressPiCellState> state_;
   CellMembers members_;
 };

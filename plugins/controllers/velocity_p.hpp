@@ -18,10 +18,10 @@
 //   view): reset the integral, no force
 //   PV = u_bar_coarse,  c_mf = clamp(phi_fine/phi_coarse, bounds) or 1,  SP = c_mf u_bar_fine
 //   e = SP - PV;  I += e T;  u = kp e + ki I   (a velocity increment per coarse step)
-//   F_i = m_i u / time_step on each coarse particle of c, scaled per particle
+//   F_i = m_i u / dt (dt the coarse step, from the setup) on each coarse particle of c, scaled per particle
 //   and component by the velocity limiter (common.hpp) against the fine
 //   cell's velocity range
-// With kp = 1/N and T = N time_step, the force held over T changes each
+// With kp = 1/N and T = N dt, the force held over T changes each
 // particle's velocity by exactly e: the loop closes in one interval.
 // The clamp of c_mf (default [0.5, 2]) is domel's: the reference corrects
 // without bounds, so a nearly empty coarse cell could command any velocity.
@@ -58,7 +58,7 @@ class VelocityP {
  public:
   static constexpr domel_kind kKind = DOMEL_KIND_CONTROLLER;
   static constexpr const char* kName = "velocity_p";
-  static constexpr const char* kVersion = "1.1.0";
+  static constexpr const char* kVersion = "2.0.0";
   static constexpr const char* kSummary =
       "P(I) velocity controller of the coarse level over the fine region: drives levels[1] (COARSE) particles "
       "towards levels[0] (FINE) mean velocity in the congruent cell (grids of both levels must match)";
@@ -67,39 +67,41 @@ class VelocityP {
   "description": "Coarse-overlap velocity controller after LIGGGHTS-PFM fix forcecontrol/region, ctrlPV velocity (docs/controllers.md). levels[0] is the fine level, which sets the target; levels[1] the coarse level, which is pushed; both grids must have the same geometry. Each control interval every coarse particle of a listed cell gets F = m u / time_step, u the controller's velocity increment towards the fine mean velocity (times the volume-fraction ratio phi_fine/phi_coarse, clamped).",
   "properties": {
     "cells": { "type": "array", "minItems": 1, "items": { "type": "integer", "minimum": 0, "maximum": 4294967294 },
-               "description": "indices ix + nx (iy + ny iz) of the cells to control (the coarse cells covered by the fine region), each listed once" },
+               "description": "indices ix + nx (iy + ny iz) of the cells to control (the coarse cells covered by the fine region), each listed once (default: every cell of the coupling's grid)" },
     "kp": { "type": "number", "minimum": 0, "x-unit": "1",
-            "description": "proportional gain k_p (the reference uses 1/N for a control interval of N coarse steps: the error then closes in one interval)" },
+            "description": "proportional gain k_p per coarse step (default 1/N for a control interval of N coarse steps, as the reference's examples: the error then closes in one interval)" },
     "ki": { "type": "number", "minimum": 0, "default": 0, "x-unit": "1/s",
             "description": "integral gain k_i (0 in the reference examples)" },
-    "time_step": { "type": "number", "exclusiveMinimum": 0, "x-unit": "s",
-                   "description": "the coarse level's time step dt: the force m u/dt changes a velocity by u per step" },
-    "mass_flow_correction": { "type": "array", "items": { "type": "boolean" },
-                              "description": "one per entry of cells: multiply the target velocity by phi_fine/phi_coarse in that cell (default: true for every cell)" },
+    "mass_flow_correction": { "oneOf": [ { "type": "boolean" }, { "type": "array", "minItems": 1, "items": { "type": "boolean" } } ],
+                              "default": true,
+                              "description": "multiply the target velocity by phi_fine/phi_coarse so that the coarse mass flux matches the fine one (docs/physics.md §5.4): true or false for every cell, or one boolean per entry of cells; false: plain velocity matching" },
     "velocity_limit": { "type": "number", "minimum": 0, "default": 0.2, "x-unit": "1",
                         "description": "relative velocity limit r: a pushed particle's velocity, predicted over the control interval, stays within the fine cell's particle velocity range widened by r (0: no limit)" },
     "correction_bounds": { "type": "array", "minItems": 2, "maxItems": 2, "default": [0.5, 2], "x-unit": "1",
                            "items": { "type": "number", "exclusiveMinimum": 0, "x-unit": "1" },
                            "description": "[lower, upper] clamp of the correction phi_fine/phi_coarse (a domel choice: a nearly empty coarse cell cannot command a huge velocity); lower <= 1 <= upper" }
   },
-  "required": ["cells", "kp", "time_step"],
+  "required": [],
   "additionalProperties": false
 })json";
 
   explicit VelocityP(const sdk::Params& p)
-      : cells_(parse_cells(p.json(), kName)),
-        kp_(non_negative(p.json(), "kp", kName, true)),
+      : host_(p.host()),
+        cells_(parse_cells(p.json(), kName)),
+        has_kp_(p.json().contains("kp")),
+        kp_(non_negative(p.json(), "kp", kName, false, 0.0)),
         ki_(non_negative(p.json(), "ki", kName, false, 0.0)),
-        dt_(non_negative(p.json(), "time_step", kName, true)),
         velocity_limit_(non_negative(p.json(), "velocity_limit", kName, false, 0.2)) {
     const std::string who = std::string(kName) + ": ";
-    if (!(dt_ > 0.0)) throw sdk::ParameterError(who + "'time_step' must be > 0 s");
     correction_.assign(cells_.size(), true);
-    if (const auto it = p.json().find("mass_flow_correction"); it != p.json().end()) {
+    if (const auto it = p.json().find("mass_flow_correction"); it != p.json().end() && it->is_boolean()) {
+      all_corrected_ = it->get<bool>();
+      correction_.assign(cells_.size(), all_corrected_);
+    } else if (it != p.json().end()) {
       if (!it->is_array() || it->size() != cells_.size())
         throw sdk::ParameterError(who +
-                                  "'mass_flow_correction' must be an array of booleans with one entry per cell (" +
-                                  std::to_string(cells_.size()) + "), got " + it->dump());
+                                  "'mass_flow_correction' must be true, false or an array of booleans with one entry "
+                                  "per entry of 'cells' (" + std::to_string(cells_.size()) + "), got " + it->dump());
       for (std::size_t a = 0; a < it->size(); ++a) {
         if (!(*it)[a].is_boolean())
           throw sdk::ParameterError(who + "mass_flow_correction[" + std::to_string(a) + "] must be true or false");
@@ -121,7 +123,28 @@ class VelocityP {
     state_.resize(cells_.size());
   }
 
+  /// The coupling's derived values (ABI 2.5): the coarse level's time step
+  /// dt of F = m u/dt, the default kp = 1/N for N coarse steps per control
+  /// interval and the default cells (all), checked against the grid.
+  void setup(const domel_control_setup_v1& s) {
+    const SetupLevels lv = checked_setup(s, kName);
+    dt_ = lv.coarse->time_step;
+    if (!has_kp_) kp_ = 1.0 / static_cast<double>(lv.coarse->steps_per_interval);  // the reference's examples
+    if (cells_.empty()) {
+      for (std::size_t c = 0; c < s.n_cells; ++c) cells_.push_back(static_cast<uint32_t>(c));
+      correction_.assign(cells_.size(), all_corrected_);
+      state_.assign(cells_.size(), VelocityPCellState{});
+    }
+    check_cells_in_setup(cells_, s, kName);
+    std::ostringstream m;
+    m << "kp = " << kp_ << (has_kp_ ? "" : " (1/N)") << " with N = " << lv.coarse->steps_per_interval
+      << " steps of " << dt_ << " s of '" << lv.coarse->name << "' per control interval; " << cells_.size()
+      << " cell(s) controlled";
+    host_.info(m.str());
+  }
+
   void control(domel_control_step_v1& step) {
+    if (!(dt_ > 0.0)) fail(kName, "the coarse time step comes from the host's setup (ABI 2.5), and setup was not called");
     const LevelPair lv = fine_and_coarse(step, kName);
     const domel_cell_grid_v1& gf = *lv.fine->cells;    // target
     const domel_cell_grid_v1& gc = *lv.coarse->cells;  // actual
@@ -208,8 +231,11 @@ class VelocityP {
   const std::vector<VelocityPCellState>& state() const { return state_; }
 
  private:
+  sdk::Host host_;
   std::vector<uint32_t> cells_;
-  double kp_, ki_, dt_, velocity_limit_;
+  bool has_kp_;
+  double kp_, ki_, dt_ = 0.0, velocity_limit_;
+  bool all_corrected_ = true;  ///< a boolean mass_flow_correction, for the default cells
   std::vector<bool> correction_;
   std::array<double, 2> bounds_{0.5, 2.0};
   std::vector<VelocityPCellState> state_;

@@ -12,6 +12,9 @@
 //    F_z = -m (u_max_z - u_min_z) of its own cell in its own grid, and
 //    F_y = the number of calls so far (the instance keeps state). It logs
 //    one line per call through the host.
+//  - abi_test_band (ABI 2.5): a controller with parameters of its own names
+//    (gain, band) that takes its coupling's derived values from setup();
+//    see the class.
 //  - abi_test_drag: F = 6 pi mu r (u_f - v) along x, times (1 - phi) of the
 //    particle's cell when a grid is given. A level without particles is
 //    reported through the host's error service, then refused.
@@ -74,6 +77,82 @@ class TestController {
 
  private:
   double gain_;
+  domel::sdk::Host host_;
+  int calls_ = 0;
+};
+
+// abi_test_band: a controller with parameters of its own names, set up by
+// the host (ABI 2.5). Per control interval each particle of level 1 (the
+// coarse one) in a cell where level 0 (the fine one) has particles gets
+// F_k = gain m (u_k - v_k) per component k whose |u_k - v_k| exceeds band,
+// u the level-0 cell's mean velocity. setup() logs what it was handed; each
+// call logs how many particles it pushed. It keeps the call count as state.
+class TestBandController {
+ public:
+  static constexpr domel_kind kKind = DOMEL_KIND_CONTROLLER;
+  static constexpr const char* kName = "abi_test_band";
+  static constexpr const char* kVersion = "1.0.0";
+  static constexpr const char* kSummary = "ABI test controller: a dead-band P velocity law with gain and band";
+  static constexpr const char* kSchema = R"json({
+  "type": "object",
+  "properties": {
+    "gain": { "type": "number", "minimum": 0, "x-unit": "1/s", "description": "relaxation rate of level 1 towards level 0's cell velocity" },
+    "band": { "type": "number", "minimum": 0, "default": 0, "x-unit": "m/s", "description": "velocity differences up to this get no force" }
+  },
+  "required": ["gain"],
+  "additionalProperties": false
+})json";
+
+  explicit TestBandController(const domel::sdk::Params& p)
+      : gain_(p.number("gain")), band_(p.has("band") ? p.number("band") : 0.0), host_(p.host()) {}
+
+  void setup(const domel_control_setup_v1& s) {
+    if (s.level_count != 2) throw domel::sdk::ParameterError("needs two levels");
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "setup: gain %.17g band %.17g interval %.17g grid %u %u %u (%zu cells) inflow cells %zu", gain_,
+                  band_, s.interval, s.nx, s.ny, s.nz, s.n_cells, s.n_inflow_cells);
+    host_.info(line);
+    for (uint32_t l = 0; l < 2; ++l) {
+      std::snprintf(line, sizeof line, "setup: level %u '%s' alpha %.17g dt %.17g steps %llu", l, s.levels[l].name,
+                    s.levels[l].coarse_grain, s.levels[l].time_step,
+                    static_cast<unsigned long long>(s.levels[l].steps_per_interval));
+      host_.info(line);
+    }
+    for (size_t a = 0; a < s.n_inflow_cells; ++a) {
+      std::snprintf(line, sizeof line, "setup: inflow cell %u direction %d %d %d", s.inflow_cell[a],
+                    s.inflow_direction[3 * a], s.inflow_direction[3 * a + 1], s.inflow_direction[3 * a + 2]);
+      host_.info(line);
+    }
+  }
+
+  void control(domel_control_step_v1& step) {
+    ++calls_;
+    const domel_cell_grid_v1& g = *step.levels[0]->cells;
+    domel_particles_v1& pc = *step.levels[1]->particles;
+    const double* u[3] = {g.ux, g.uy, g.uz};
+    const double* v[3] = {pc.vx, pc.vy, pc.vz};
+    double* f[3] = {pc.fx, pc.fy, pc.fz};
+    size_t pushed = 0;
+    for (size_t k = 0; k < pc.n; ++k) {
+      const uint32_t c = pc.cell[k];
+      if (c == UINT32_MAX || g.count[c] == 0) continue;
+      bool any = false;
+      for (int a = 0; a < 3; ++a) {
+        const double dv = u[a][c] - v[a][k];
+        if (std::fabs(dv) <= band_) continue;
+        f[a][k] += gain_ * pc.mass[k] * dv;
+        any = true;
+      }
+      pushed += any ? 1 : 0;
+    }
+    host_.info("band call " + std::to_string(calls_) + ": pushed " + std::to_string(pushed));
+  }
+  void save_state(domel::sdk::StateWriter& w) const { w.put(calls_); }
+  void load_state(domel::sdk::StateReader& r) { calls_ = r.get<int>(); }
+
+ private:
+  double gain_, band_;
   domel::sdk::Host host_;
   int calls_ = 0;
 };
@@ -199,4 +278,4 @@ class TestLinearDrag {
 
 }  // namespace
 
-DOMEL_PLUGIN_LIBRARY("abi_families", "1.0.0", TestController, TestDrag, TestLinearDrag)
+DOMEL_PLUGIN_LIBRARY("abi_families", "1.0.0", TestController, TestBandController, TestDrag, TestLinearDrag)

@@ -147,6 +147,34 @@ struct TwoLevels {
 
 std::size_t cell(uint32_t ix, uint32_t iz) { return ix + 2u * iz; }
 
+// What the host sets a controller up with (ABI 2.5) for the 2 x 1 x 2 grid
+// of 1 cm cells: the fine level's step and steps per interval, the coarse
+// level's, and the inflow cells with their inward normals.
+struct HostSetup {
+  domel_control_level_setup_v1 levels[2]{};
+  std::vector<uint32_t> inflow_cell;
+  std::vector<int32_t> inflow_direction;
+  domel_control_setup_v1 view{};
+  HostSetup(const HostSetup&) = delete;
+  HostSetup& operator=(const HostSetup&) = delete;
+  HostSetup(double dt_fine, uint64_t n_fine, double dt_coarse, uint64_t n_coarse, std::vector<uint32_t> cells = {},
+        std::vector<int32_t> directions = {})
+      : inflow_cell(std::move(cells)), inflow_direction(std::move(directions)) {
+    static_assert(!std::is_copy_constructible_v<HostSetup>, "view points into the object");
+    levels[0] = {sizeof(domel_control_level_setup_v1), 0, "fine", 1.0, dt_fine, n_fine};
+    levels[1] = {sizeof(domel_control_level_setup_v1), 0, "coarse", 2.0, dt_coarse, n_coarse};
+    view.struct_size = sizeof view;
+    view.level_count = 2;
+    view.interval = dt_fine * static_cast<double>(n_fine);
+    view.levels = levels;
+    view.nx = 2, view.ny = 1, view.nz = 2, view.n_cells = 4;
+    for (int a = 0; a < 3; ++a) view.spacing[a] = 0.01;
+    view.n_inflow_cells = inflow_cell.size();
+    view.inflow_cell = inflow_cell.data();
+    view.inflow_direction = inflow_direction.data();
+  }
+};
+
 // ----------------------------------------------------------------- stress_pi
 //
 // The base case: cell 2 (x in [0, 1] cm, z in [1, 2] cm) under a top inflow
@@ -556,10 +584,11 @@ TEST(StressPi, RefusesBadParameters) {
   auto has = [](const std::string& msg, const char* part) {
     return ::testing::AssertionResult(msg.find(part) != std::string::npos) << "'" << msg << "' lacks '" << part << "'";
   };
-  EXPECT_TRUE(has(without("cells"), "missing required 'cells'"));
-  EXPECT_TRUE(has(without("directions"), "missing required 'directions'"));
-  EXPECT_TRUE(has(without("kp"), "missing required number 'kp'"));
-  EXPECT_TRUE(has(without("ki"), "missing required number 'ki'"));
+  // cells and directions go together; without both, and without gains, the defaults come from the setup
+  EXPECT_TRUE(has(without("cells"), "give 'cells' and 'directions' together"));
+  EXPECT_TRUE(has(without("directions"), "give 'cells' and 'directions' together"));
+  EXPECT_EQ(without("kp"), "");
+  EXPECT_EQ(without("ki"), "");
   EXPECT_TRUE(has(with("cells", json::array()), "non-empty array"));
   EXPECT_TRUE(has(with("cells", {-1}), "cells[0] must be an integer cell index >= 0"));
   EXPECT_TRUE(has(with("cells", {1.5}), "cells[0] must be an integer"));
@@ -617,8 +646,13 @@ struct VelocityCase {
     gf.u[2] = {-0.3, -0.3, -0.3, 0.0};
     fine0 = L.fine.p.add(0.015, 0.005, 0.005, 0.0005, 1e-4, 1, -0.3);
   }
-  static json params() {
-    return {{"cells", {1}}, {"kp", 0.1}, {"time_step", kDt}, {"velocity_limit", 0}};
+  static json params() { return {{"cells", {1}}, {"kp", 0.1}, {"velocity_limit", 0}}; }
+  /// The coarse level's step dt and N = T/dt = 10 steps per interval come from the setup.
+  static HostSetup setup() { return HostSetup(kDt / 2, 20, kDt, 10); }
+  static VelocityP make(const json& p) {
+    VelocityP m{Params(p)};
+    m.setup(setup().view);
+    return m;
   }
 };
 
@@ -627,7 +661,7 @@ struct VelocityCase {
 // Guards F_i = m_i u/dt with kp = 1/N: held for N steps of dt it changes every velocity by e (§5.4).
 TEST(VelocityP, ClosesTheErrorInOneInterval) {
   VelocityCase c;
-  VelocityP model{Params(VelocityCase::params())};
+  VelocityP model = VelocityCase::make(VelocityCase::params());
   model.control(c.L.step(VelocityCase::kT));
   const auto& s = model.state()[0];
   EXPECT_TRUE(s.controlled);
@@ -673,7 +707,7 @@ TEST(VelocityP, MassFlowCorrectionScalesAndClamps) {
     c.L.coarse.grid.phi[1] = phi_c;
     c.L.fine.grid.phi[2] = 0.5;  // cell 2, correction off: c_mf = 1 whatever the ratio (5)
     c.L.coarse.grid.phi[2] = 0.1;
-    VelocityP model{Params(p)};
+    VelocityP model = VelocityCase::make(p);
     model.control(c.L.step(VelocityCase::kT));
     const auto& s1 = model.state()[0];
     EXPECT_TRUE(close(s1.correction, c_mf)) << phi_f;
@@ -691,7 +725,7 @@ TEST(VelocityP, MassFlowCorrectionScalesAndClamps) {
   c.L.coarse.grid.phi[1] = 0.2;
   json q = VelocityCase::params();
   q["correction_bounds"] = {0.8, 1.25};
-  VelocityP model{Params(q)};
+  VelocityP model = VelocityCase::make(q);
   model.control(c.L.step(VelocityCase::kT));
   EXPECT_TRUE(close(model.state()[0].correction, 1.25));
 }
@@ -707,7 +741,7 @@ TEST(VelocityP, VelocityLimitLandsExactlyOnTheBound) {
   p.vz[c.c2] = -0.35;  // already beyond the limit: lambda = 0
   json q = VelocityCase::params();
   q["velocity_limit"] = 0.2;
-  VelocityP model{Params(q)};
+  VelocityP model = VelocityCase::make(q);
   model.control(c.L.step(VelocityCase::kT));
   EXPECT_TRUE(close(p.fz[c.c0], -10.0));  // -0.05 -> -0.25: inside, lambda = 1
   EXPECT_TRUE(close(p.fz[c.c1], -10.0, 1e-12));  // -20 N times 0.5
@@ -721,7 +755,7 @@ TEST(VelocityP, IntegralAccumulatesAndEmptyCellResets) {
   VelocityCase c;
   json q = VelocityCase::params();
   q["ki"] = 1.0 / VelocityCase::kT;  // 5e4 1/s
-  VelocityP model{Params(q)};
+  VelocityP model = VelocityCase::make(q);
   model.control(c.L.step(VelocityCase::kT));
   // I = e T = -4e-6 m, u = -0.02 + 5e4 (-4e-6) = -0.22 m/s
   EXPECT_TRUE(close(model.state()[0].integral[2], -4e-6));
@@ -732,7 +766,7 @@ TEST(VelocityP, IntegralAccumulatesAndEmptyCellResets) {
   EXPECT_TRUE(close(c.L.coarse.p.fz[c.c0], -210.0));
   for (int which = 0; which < 3; ++which) {
     VelocityCase d;
-    VelocityP m{Params(q)};
+    VelocityP m = VelocityCase::make(q);
     m.control(d.L.step(VelocityCase::kT));
     if (which < 2) {
       (which == 0 ? d.L.fine.grid : d.L.coarse.grid).count[1] = 0;
@@ -763,14 +797,13 @@ TEST(VelocityP, RefusesBadParameters) {
   auto has = [](const std::string& msg, const char* part) {
     return ::testing::AssertionResult(msg.find(part) != std::string::npos) << "'" << msg << "' lacks '" << part << "'";
   };
-  EXPECT_TRUE(has(without("cells"), "velocity_p: missing required 'cells'"));
-  EXPECT_TRUE(has(without("kp"), "missing required number 'kp'"));
-  EXPECT_TRUE(has(without("time_step"), "missing required number 'time_step'"));
-  EXPECT_TRUE(has(with("time_step", 0), "'time_step' must be > 0 s"));
+  EXPECT_EQ(without("cells"), "");  // every cell of the grid, from the setup
+  EXPECT_EQ(without("kp"), "");     // 1/N, from the setup
+  EXPECT_EQ(with("mass_flow_correction", false), "");
   EXPECT_TRUE(has(with("kp", -1), "'kp' must be a finite number >= 0"));
   EXPECT_TRUE(has(with("ki", -1), "'ki' must be a finite number >= 0"));
   EXPECT_TRUE(has(with("cells", {3, 1, 3}), "cell 3 is listed twice"));
-  EXPECT_TRUE(has(with("mass_flow_correction", {true, false}), "one entry per cell (1)"));
+  EXPECT_TRUE(has(with("mass_flow_correction", {true, false}), "one entry per entry of 'cells' (1)"));
   EXPECT_TRUE(has(with("mass_flow_correction", {1}), "mass_flow_correction[0] must be true or false"));
   EXPECT_TRUE(has(with("correction_bounds", {0.5}), "'correction_bounds' must be [lower, upper]"));
   EXPECT_TRUE(has(with("correction_bounds", {0, 2}), "0 < lower <= 1 <= upper"));
@@ -794,7 +827,7 @@ TEST(ControllerSchema, DocumentsEveryParameter) {
     }
   }
   const json sp = json::parse(StressPi::kSchema);
-  EXPECT_EQ(sp.at("required"), json::array({"cells", "directions", "kp", "ki"}));
+  EXPECT_EQ(sp.at("required"), json::array());  // the rest defaults from the setup
   EXPECT_EQ(sp.at("properties").at("kd").at("default"), 0);
   EXPECT_EQ(sp.at("properties").at("layer_diameters").at("default"), 1.4);
   EXPECT_EQ(sp.at("properties").at("fade_fraction").at("default"), 0.125);
@@ -802,11 +835,12 @@ TEST(ControllerSchema, DocumentsEveryParameter) {
   EXPECT_EQ(sp.at("properties").at("ki").at("x-unit"), "1/s");
   EXPECT_EQ(sp.at("properties").at("kd").at("x-unit"), "s");
   const json vp = json::parse(VelocityP::kSchema);
-  EXPECT_EQ(vp.at("required"), json::array({"cells", "kp", "time_step"}));
+  EXPECT_EQ(vp.at("required"), json::array());
+  EXPECT_FALSE(vp.at("properties").contains("time_step"));  // the setup's, not a parameter
+  EXPECT_EQ(vp.at("properties").at("mass_flow_correction").at("default"), true);
   EXPECT_EQ(vp.at("properties").at("ki").at("default"), 0);
   EXPECT_EQ(vp.at("properties").at("velocity_limit").at("default"), 0.2);
   EXPECT_EQ(vp.at("properties").at("correction_bounds").at("default"), json::array({0.5, 2}));
-  EXPECT_EQ(vp.at("properties").at("time_step").at("x-unit"), "s");
 
   using domel::platform::SchemaValidator;
   const SchemaValidator vs(sp), vv(vp);
@@ -825,7 +859,7 @@ TEST(ControllerSchema, DocumentsEveryParameter) {
   bad["directions"] = {{0, 0}};
   EXPECT_FALSE(vs.is_valid(bad));
   json vbad = VelocityCase::params();
-  vbad["time_step"] = 0;
+  vbad["time_step"] = 1e-5;
   EXPECT_FALSE(vv.is_valid(vbad));
   vbad = VelocityCase::params();
   vbad["mass_flow_correction"] = {1};
@@ -864,12 +898,22 @@ TEST(ControllerAbi, GeneratedCallbacksMatchTheClasses) {
   ASSERT_EQ(ExportVelocity::create(VelocityCase::params().dump().c_str(), nullptr, &inst, err, sizeof err), DOMEL_OK)
       << err;
   VelocityCase v;
+  const HostSetup& vs = VelocityCase::setup();
+  ASSERT_EQ(ExportVelocity::control_setup(inst, &vs.view, err, sizeof err), DOMEL_OK) << err;
   ASSERT_EQ(ExportVelocity::control(inst, &v.L.step(VelocityCase::kT), err, sizeof err), DOMEL_OK) << err;
   EXPECT_TRUE(close(v.L.coarse.p.fz[v.c2], -40.0));
   v.L.step(VelocityCase::kT);
   v.L.fine.grid.view.nz = 3;
   EXPECT_EQ(ExportVelocity::control(inst, &v.L.s, err, sizeof err), DOMEL_ERR_RUNTIME);
   EXPECT_NE(std::string(err).find("velocity_p:"), std::string::npos) << err;
+  // a setup the model refuses is DOMEL_ERR_PARAMETER with its message: cell 7 beyond the 4 cells
+  ExportVelocity::destroy(inst);
+  inst = nullptr;
+  ASSERT_EQ(ExportVelocity::create(R"({"cells":[7]})", nullptr, &inst, err, sizeof err), DOMEL_OK) << err;
+  EXPECT_EQ(ExportVelocity::control_setup(inst, &vs.view, err, sizeof err), DOMEL_ERR_PARAMETER);
+  EXPECT_NE(std::string(err).find("cells[0] = 7 lies outside the coupling's grid (2 x 1 x 2 = 4 cells"),
+            std::string::npos)
+      << err;
   ExportVelocity::destroy(inst);
 }
 
@@ -887,6 +931,7 @@ TEST(ControllerLibrary, LoadsThroughThePluginRegistry) {
   EXPECT_NE(m->summary.find("levels[0] (FINE)"), std::string::npos);
   EXPECT_NE(registry.find(DOMEL_KIND_CONTROLLER, "stress_pi")->summary.find("levels[1] (COARSE)"), std::string::npos);
   ModelInstance inst(*m, VelocityCase::params(), "controller_test");
+  EXPECT_TRUE(inst.control_setup(VelocityCase::setup().view));
   VelocityCase v;
   inst.control(v.L.step(VelocityCase::kT));
   EXPECT_TRUE(close(v.L.coarse.p.fz[v.c1], -20.0));
@@ -947,4 +992,63 @@ TEST(ControllerLibrary, SavedStateContinuesExactlyAndAWrongStateIsRefused) {
   } catch (const PluginError& e) {
     EXPECT_NE(std::string(e.what()).find("load_state failed"), std::string::npos) << e.what();
   }
+}
+
+// Guards the defaults taken from the setup (ABI 2.5): stress_pi without kp,
+// ki, cells, directions and limit_horizon pushes exactly as with kp = 1/N,
+// ki = 1/(N dt_fine), the inflow cells with their inward normals and a
+// horizon of one fine step written out (N = 15 fine steps of 1e-6 s: the
+// hand-computed case above); without setup it refuses to run; a setup with
+// no inflow cell, or cells beyond the grid, is refused.
+TEST(StressPi, DefaultsComeFromTheSetup) {
+  json explicit_p = StressCase::params();
+  explicit_p["velocity_limit"] = 0.2;  // the limiter on, so that the horizon matters
+  explicit_p["limit_horizon"] = 1e-6;
+  explicit_p["cells"] = {2, 3};
+  explicit_p["directions"] = {{0, 0, -1}, {0, 0, -1}};
+  const json defaults = {{"velocity_limit", 0.2}};
+  StressCase a, b;
+  // a coarse velocity range of +-1 mm/s in cell 2: over one fine step the push of P0 (u1/m = 213 m/s^2)
+  // stays inside it, over the whole interval T it would not
+  for (StressCase* c : {&a, &b}) {
+    c->L.coarse.grid.u_min[2][2] = -1e-3;
+    c->L.coarse.grid.u_max[2][2] = 1e-3;
+  }
+  StressPi written{Params(explicit_p)};
+  written.control(a.L.step(StressCase::kT));
+  StressPi derived{Params(defaults)};
+  EXPECT_THROW(derived.control(b.L.step(StressCase::kT)), std::runtime_error);  // no setup: no gains
+  const HostSetup top(1e-6, 15, 2e-6, 8, {2, 3}, {0, 0, -1, 0, 0, -1});  // cells 2, 3 under the +z face
+  derived.setup(top.view);
+  derived.control(b.L.step(StressCase::kT));
+  EXPECT_EQ(derived.cells(), (std::vector<uint32_t>{2, 3}));
+  EXPECT_EQ(a.L.fine.p.fz, b.L.fine.p.fz);
+  EXPECT_TRUE(close(b.L.fine.p.fz[b.p0], -StressCase::u1()));  // not throttled: the horizon is one fine step
+
+  StressPi none{Params(defaults)};
+  EXPECT_THROW(none.setup(HostSetup(1e-6, 15, 2e-6, 8).view), ParameterError);  // no inflow cell, no cells
+  StressPi beyond{Params(StressCase::params())};
+  json p = StressCase::params();
+  p["cells"] = {4};
+  StressPi outside{Params(p)};
+  EXPECT_NO_THROW(beyond.setup(top.view));
+  EXPECT_THROW(outside.setup(top.view), ParameterError);
+}
+
+// velocity_p without kp and cells pushes exactly as with kp = 1/N_c (N_c = 10
+// coarse steps per interval) and every cell listed; its force m u/dt takes dt
+// from the setup's coarse level.
+TEST(VelocityP, DefaultsComeFromTheSetup) {
+  json explicit_p = VelocityCase::params();
+  explicit_p["cells"] = {0, 1, 2, 3};
+  VelocityCase a, b;
+  VelocityP written = VelocityCase::make(explicit_p);
+  written.control(a.L.step(VelocityCase::kT));
+  VelocityP derived = VelocityCase::make({{"velocity_limit", 0}});
+  derived.control(b.L.step(VelocityCase::kT));
+  EXPECT_EQ(derived.cells(), (std::vector<uint32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(a.L.coarse.p.fz, b.L.coarse.p.fz);
+  EXPECT_TRUE(close(b.L.coarse.p.fz[b.c0], -10.0));  // the hand-computed case: kp = 0.1, dt = 2e-6 s
+  VelocityP unset{Params(VelocityCase::params())};
+  EXPECT_THROW(unset.control(b.L.step(VelocityCase::kT)), std::runtime_error);  // no dt without setup
 }

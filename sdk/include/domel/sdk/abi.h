@@ -41,7 +41,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 2
-#define DOMEL_ABI_MINOR 4
+#define DOMEL_ABI_MINOR 5
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -349,6 +349,47 @@ typedef struct domel_control_step_v1 {
   domel_level_v1* const* levels;
 } domel_control_step_v1;
 
+/** One level of a coupling as its controller is set up (ABI 2.5): what
+ *  the host derived from the scenario for that level. */
+typedef struct domel_control_level_setup_v1 {
+  uint32_t struct_size;
+  uint32_t reserved;          /**< 0 */
+  const char* name;           /**< subdomain name */
+  double coarse_grain;        /**< coarse-grain ratio alpha  [-] */
+  double time_step;           /**< the level's time step  [s] */
+  uint64_t steps_per_interval; /**< the level's steps in one control interval */
+} domel_control_level_setup_v1;
+
+/** What a controller is set up for (ABI 2.5), once, before the run: the
+ *  derived values of its coupling, so that a model computes its defaults
+ *  (a gain of 1/N for N steps per interval) and checks its parameters (cell
+ *  indices) from them rather than from parameters the host would have to
+ *  invent. levels[] are in the order of the control steps' levels. The
+ *  inflow cells are the grid's cells touching a face through which material
+ *  enters levels[0] (the scenario's inflow_faces), each with its inward
+ *  normal (components -1, 0 or 1; a corner cell of two inflow faces has two
+ *  non-zero components), in increasing cell index. */
+typedef struct domel_control_setup_v1 {
+  uint32_t struct_size;
+  uint32_t level_count;
+  double interval;            /**< length of the control interval  [s] */
+  const domel_control_level_setup_v1* levels;
+  uint32_t nx, ny, nz;        /**< the cells of the levels' common grid */
+  size_t n_cells;             /**< nx ny nz */
+  double origin[3];           /**< lower corner of cell (0,0,0)  [m] */
+  double spacing[3];          /**< cell edge lengths  [m] */
+  size_t n_inflow_cells;
+  const uint32_t* inflow_cell;      /**< n_inflow_cells cell indices */
+  const int32_t* inflow_direction;  /**< 3 per inflow cell: the inward normal */
+} domel_control_setup_v1;
+
+/* Called once after create and before any other call (load_state and
+ * control included): the model resolves its defaults from the setup and may
+ * refuse it (DOMEL_ERR_PARAMETER with a message: a cell index beyond the
+ * grid), which the host reports at the controller's block before the run. */
+typedef domel_status (*domel_control_setup_fn)(void* instance, const domel_control_setup_v1* setup, char* err,
+                                               size_t err_capacity);
+
 /* Called once per control interval, from one thread at a time: a controller
  * may keep state (an integral term) in its instance. */
 typedef domel_status (*domel_control_fn)(void* instance, domel_control_step_v1* step, char* err,
@@ -362,6 +403,8 @@ typedef struct domel_controller_family_v1 {
   /* ABI 2.3; optional: NULL, or beyond struct_size, means not provided */
   domel_save_state_fn save_state; /**< its state for a checkpoint (with load_state) */
   domel_load_state_fn load_state;
+  /* ABI 2.5; optional */
+  domel_control_setup_fn setup;   /**< the coupling's derived values, before the run */
 } domel_controller_family_v1;
 
 /* ------------------------------------------------------------------------ */

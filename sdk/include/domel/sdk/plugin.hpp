@@ -22,6 +22,7 @@
 //                   into runs of one pair before compute() sees it
 //   insertion       void insert(const domel_insert_request_v1&, domel::sdk::Inserted& out);
 //   controller      void control(domel_control_step_v1&);
+//                   optional (ABI 2.5): void setup(const domel_control_setup_v1&);
 //   fluid_coupler   void exchange(domel_fluid_exchange_v1&);
 //                   optional: void fields(domel_fluid_fields_v1&);
 //                             void limits(domel_fluid_limits_v1&);
@@ -270,6 +271,16 @@ struct has_state<M, std::void_t<decltype(std::declval<const M&>().save_state(std
                                 decltype(std::declval<M&>().load_state(std::declval<StateReader&>()))>>
     : std::true_type {};
 
+/// A controller may provide `void setup(const domel_control_setup_v1&)`
+/// (ABI 2.5): its coupling's derived values (time steps, steps per control
+/// interval, the grid, the inflow cells), once before the run; it throws
+/// ParameterError to refuse them.
+template <class M, class = void>
+struct has_setup : std::false_type {};
+template <class M>
+struct has_setup<M, std::void_t<decltype(std::declval<M&>().setup(std::declval<const domel_control_setup_v1&>()))>>
+    : std::true_type {};
+
 constexpr bool is_contact_kind(domel_kind k) {
   return k == DOMEL_KIND_NORMAL || k == DOMEL_KIND_DAMPING || k == DOMEL_KIND_TANGENTIAL ||
          k == DOMEL_KIND_ROLLING || k == DOMEL_KIND_TWISTING;
@@ -412,6 +423,27 @@ struct Export {
     }
   }
 
+  static domel_status control_setup(void* self, const domel_control_setup_v1* setup, char* err, std::size_t cap) {
+    if constexpr (has_setup<M>::value) {
+      try {
+        static_cast<Instance<M>*>(self)->model.setup(*setup);
+        return DOMEL_OK;
+      } catch (const ParameterError& e) {
+        write_message(err, cap, e.what());
+        return DOMEL_ERR_PARAMETER;
+      } catch (const std::exception& e) {
+        write_message(err, cap, e.what());
+      } catch (...) {
+        write_message(err, cap, "unknown exception in controller setup");
+      }
+      return DOMEL_ERR_RUNTIME;
+    } else {
+      (void)self; (void)setup;
+      write_message(err, cap, "no setup");
+      return DOMEL_ERR_RUNTIME;
+    }
+  }
+
   static domel_status exchange(void* self, domel_fluid_exchange_v1* ex, char* err, std::size_t cap) {
     if constexpr (M::kKind == DOMEL_KIND_FLUID_COUPLER) {
       return guarded(err, cap, "fluid coupler", [&] {
@@ -494,7 +526,8 @@ struct Export {
     } else if constexpr (M::kKind == DOMEL_KIND_CONTROLLER) {
       static const domel_controller_family_v1 t = {sizeof(domel_controller_family_v1), 0u, &Export::control,
                                                    has_state<M>::value ? &Export::save_state : nullptr,
-                                                   has_state<M>::value ? &Export::load_state : nullptr};
+                                                   has_state<M>::value ? &Export::load_state : nullptr,
+                                                   has_setup<M>::value ? &Export::control_setup : nullptr};
       return &t;
     } else {
       static_assert(M::kKind == DOMEL_KIND_FLUID_COUPLER, "a model's kKind must be a domel_kind");
