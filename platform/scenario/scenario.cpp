@@ -181,6 +181,23 @@ json composed_scenario_schema(const PluginRegistry& registry) {
   fill("twisting_model", DOMEL_KIND_TWISTING, true);
   fill("insertion_model", DOMEL_KIND_INSERTION, false);
   fill("fluid_model", DOMEL_KIND_FLUID_COUPLER, false);
+  // A coupling's controller blocks: any loaded controller's block; a block
+  // without "model" is the default model's (its "model" not required).
+  for (const char* key : {"stress_control", "velocity_control"}) {
+    json& block = schema["$defs"]["coupling"]["properties"][key];
+    const json fallback = block["properties"]["model"]["default"];
+    json alternatives = json::array();
+    for (const auto& m : registry.models()) {
+      if (m.desc.kind != DOMEL_KIND_CONTROLLER) continue;
+      json s = model_block_schema(m);
+      alternatives.push_back(s);
+      if (json(m.name) != fallback) continue;
+      json& req = s["required"];
+      req.erase(std::remove(req.begin(), req.end(), json("model")), req.end());
+      alternatives.push_back(s);
+    }
+    if (!alternatives.empty()) block["anyOf"] = alternatives;
+  }
   return schema;
 }
 
