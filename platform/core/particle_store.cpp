@@ -5,6 +5,7 @@
 #include "core/archive.hpp"
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
@@ -29,6 +30,24 @@ void ParticleStore::add(std::uint64_t pid, double px, double py, double pz, doub
     for (auto* v : {&ext_fx, &ext_fy, &ext_fz}) v->push_back(0.0);
   for (auto& a : aux) a.push_back(0.0);
   ++layout_version;
+}
+
+std::size_t ParticleStore::add_field(const std::string& name, unsigned sync) {
+  bool taken = false;
+  for_each_field([&](const char* n, const auto&, unsigned) { taken = taken || name == n; });
+  if (taken || name.empty() || name == "external_force" || name == "aux_count" || name == "layout_version")
+    throw std::invalid_argument("ParticleStore::add_field: the name '" + name + "' is taken");
+  aux.emplace_back(size(), 0.0);
+  aux_name_.push_back(name);
+  aux_sync_.push_back(sync);
+  return aux.size() - 1;
+}
+
+ParticleStore ParticleStore::empty_like() const {
+  ParticleStore s;
+  if (external_force_) s.enable_external_force();
+  for (std::size_t a = 0; a < aux.size(); ++a) s.add_field(aux_name_[a], aux_sync_[a]);
+  return s;
 }
 
 void ParticleStore::swap_remove(std::size_t k) {
@@ -94,41 +113,37 @@ void ParticleStore::permute(const std::vector<std::uint32_t>& order) {
 
 namespace domel::platform {
 
-namespace {
-/// The store's double arrays with their section names, for save() and load() alike.
-const std::pair<const char*, std::vector<double> ParticleStore::*> kRealArrays[] = {
-    {"x", &ParticleStore::x}, {"y", &ParticleStore::y}, {"z", &ParticleStore::z}, {"vx", &ParticleStore::vx},
-    {"vy", &ParticleStore::vy}, {"vz", &ParticleStore::vz}, {"wx", &ParticleStore::wx}, {"wy", &ParticleStore::wy},
-    {"wz", &ParticleStore::wz}, {"fx", &ParticleStore::fx}, {"fy", &ParticleStore::fy}, {"fz", &ParticleStore::fz},
-    {"tx", &ParticleStore::tx}, {"ty", &ParticleStore::ty}, {"tz", &ParticleStore::tz},
-    {"radius", &ParticleStore::radius}, {"mass", &ParticleStore::mass}, {"inv_mass", &ParticleStore::inv_mass},
-    {"inv_inertia", &ParticleStore::inv_inertia}};
-}  // namespace
-
 void ParticleStore::fields(CheckpointFields& f) {
-  f("id", id);
-  for (const auto& [name, member] : kRealArrays) f(name, this->*member);
-  f("contacts", contacts);
-  f("flags", flags);
-  f("material", material);
-  f("external_force", external_force_);
-  if (external_force_) {
-    f("ext_fx", ext_fx);
-    f("ext_fy", ext_fy);
-    f("ext_fz", ext_fz);
-  } else {
-    ext_fx.clear(), ext_fy.clear(), ext_fz.clear();
-  }
-  std::uint64_t n_aux = aux.size();
-  f("aux_count", n_aux);
-  if (f.loading() && n_aux != aux.size())
-    f.reader().fail(f.prefix() + "aux_count", "holds " + std::to_string(n_aux) +
-                                                  " extra per-particle arrays; this scenario uses " +
-                                                  std::to_string(aux.size()));
-  for (std::size_t a = 0; a < aux.size(); ++a) f("aux" + std::to_string(a), aux[a]);
+  // the fields of for_each_field() with kCheckpoint, in its order; the
+  // external-force switch after the material (it decides whether the
+  // external forces follow), the aux count before the aux fields (a file of
+  // another layout is refused there)
+  bool aux_counted = false;
+  auto count_aux = [&] {
+    if (aux_counted) return;
+    aux_counted = true;
+    std::uint64_t n_aux = aux.size();
+    f("aux_count", n_aux);
+    if (f.loading() && n_aux != aux.size())
+      f.reader().fail(f.prefix() + "aux_count", "holds " + std::to_string(n_aux) +
+                                                    " extra per-particle arrays; this scenario uses " +
+                                                    std::to_string(aux.size()));
+  };
+  for_each_field([&](const char* name, auto& v, unsigned sync) {
+    if (!aux.empty() && static_cast<const void*>(&v) == static_cast<const void*>(&aux.front())) count_aux();
+    if (sync & kCheckpoint) f(name, v);
+    if (&v == static_cast<const void*>(&material)) {
+      f("external_force", external_force_);
+      if (!external_force_) ext_fx.clear(), ext_fy.clear(), ext_fz.clear();
+    }
+  });
+  count_aux();
   f("layout_version", layout_version);
   if (!f.loading()) return;
   const std::size_t n = id.size();
+  for_each_field([&](const char*, auto& v, unsigned sync) {
+    if (!(sync & kCheckpoint)) v.assign(n, {});  // not saved: zero, as for a new particle
+  });
   bool same = true;
   for_each_array([&](const auto& v) { same = same && v.size() == n; });
   if (!same) f.reader().fail(f.prefix() + "id", "has per-particle arrays of different lengths");

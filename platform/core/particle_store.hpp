@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The particle store of one subdomain: structure of arrays, one std::vector
-// per scalar component, no per-particle objects. Everything that moves with a
-// particle when the store is re-ordered is listed in for_each_array().
+// per scalar component, no per-particle objects. Every per-particle field is
+// listed once, in for_each_field(), with its sync policy: what a re-order,
+// a removal, a rank's migration, its ghosts, the reverse exchange and a
+// checkpoint do with it all follow from that list (waLBerla mesa_pd's
+// property list is the model: issue 40).
 #pragma once
 
 #include <cstddef>
@@ -37,10 +40,23 @@ struct ParticleStore {
   /// force reset. Empty until enable_external_force(); from then on it moves
   /// with the particles like every other array, and new particles get 0.
   std::vector<double> ext_fx, ext_fy, ext_fz;
-  /// Further per-particle values a module asks for with add_aux() (the fluid
-  /// coupling's linearised drag and velocity integral): each moves with the
-  /// particles like every other array, and new particles get 0.
+  /// Further per-particle values a module asks for with add_aux() or
+  /// add_field() (the fluid coupling's linearised drag and velocity
+  /// integral): each moves with the particles like every other array, with
+  /// its own name and sync policy, and new particles get 0.
   std::vector<std::vector<double>> aux;
+
+  /// What happens to a field besides moving with its particle in the store
+  /// (a re-order, a removal): a set of these per field (for_each_field()).
+  enum Sync : unsigned {
+    kMigrate = 1u << 0,      ///< goes with its particle to a new owner rank, and into a gather
+    kGhostBuild = 1u << 1,   ///< copied into the ghosts at a list build
+    kGhostUpdate = 1u << 2,  ///< refreshed in the ghosts every step between builds (doubles)
+    kReverse = 1u << 3,      ///< the ghosts' values added to their owners' every step (doubles)
+    kCheckpoint = 1u << 4,   ///< written to checkpoints and read back
+  };
+  /// The policy of a field that only rides along: it travels, and is saved.
+  static constexpr unsigned kCarried = kMigrate | kGhostBuild | kCheckpoint;
 
   /// A fixed particle is never moved (inverse mass and inertia 0, so the
   /// integrator leaves it at rest) but is a full contact partner with its real
@@ -58,12 +74,23 @@ struct ParticleStore {
     external_force_ = true;
   }
 
-  /// Append k zero-filled aux arrays; returns the index of the first.
+  /// Append k zero-filled aux arrays named aux<index>, carried
+  /// (kCarried); returns the index of the first.
   std::size_t add_aux(std::size_t k) {
     const std::size_t first = aux.size();
-    for (std::size_t a = 0; a < k; ++a) aux.emplace_back(size(), 0.0);
+    for (std::size_t a = 0; a < k; ++a) add_field("aux" + std::to_string(aux.size()), kCarried);
     return first;
   }
+  /// Append one zero-filled per-particle field (an aux array) with its name
+  /// (its checkpoint section) and sync policy; returns its index in aux.
+  /// Throws std::invalid_argument for a name already taken.
+  std::size_t add_field(const std::string& name, unsigned sync);
+  /// The aux fields' names and sync policies, by index.
+  const std::vector<std::string>& aux_names() const { return aux_name_; }
+  const std::vector<unsigned>& aux_sync() const { return aux_sync_; }
+  /// An empty store with the same fields (the external-force switch and the
+  /// aux fields with their names and policies), to gather particles into.
+  ParticleStore empty_like() const;
 
   /// Incremented by every change of which particle sits in which slot (add,
   /// swap_remove, permute), so that index-based structures (neighbour lists)
@@ -113,24 +140,43 @@ struct ParticleStore {
   /// close in memory, so the pair loop's gathers hit the cache.
   std::vector<std::uint32_t> spatial_order(double cell) const;
 
+  /// Visit every per-particle field, f(name, array, sync), in one fixed
+  /// order: the one list of the store's fields. The contact counts go home
+  /// from the ghosts on demand (reverse_counts), not every step.
+  template <class F>
+  void for_each_field(F&& f) {
+    constexpr unsigned motion = kCarried | kGhostUpdate, load = kCarried | kReverse;
+    f("id", id, kCarried);
+    f("x", x, motion); f("y", y, motion); f("z", z, motion);
+    f("vx", vx, motion); f("vy", vy, motion); f("vz", vz, motion);
+    f("wx", wx, motion); f("wy", wy, motion); f("wz", wz, motion);
+    f("fx", fx, load); f("fy", fy, load); f("fz", fz, load);
+    f("tx", tx, load); f("ty", ty, load); f("tz", tz, load);
+    f("radius", radius, kCarried); f("mass", mass, kCarried); f("inv_mass", inv_mass, kCarried);
+    f("inv_inertia", inv_inertia, kCarried);
+    f("contacts", contacts, kCarried); f("flags", flags, kCarried); f("material", material, kCarried);
+    if (external_force_) {
+      f("ext_fx", ext_fx, kCarried); f("ext_fy", ext_fy, kCarried); f("ext_fz", ext_fz, kCarried);
+    }
+    for (std::size_t a = 0; a < aux.size(); ++a) f(aux_name_[a].c_str(), aux[a], aux_sync_[a]);
+  }
+  template <class F>
+  void for_each_field(F&& f) const {
+    const_cast<ParticleStore*>(this)->for_each_field(
+        [&f](const char* name, const auto& v, unsigned sync) { f(name, v, sync); });
+  }
   /// Visit every per-particle array (for permutation, removal, resizing).
   template <class F>
   void for_each_array(F&& f) {
-    f(id); f(x); f(y); f(z); f(vx); f(vy); f(vz); f(wx); f(wy); f(wz);
-    f(fx); f(fy); f(fz); f(tx); f(ty); f(tz);
-    f(radius); f(mass); f(inv_mass); f(inv_inertia); f(contacts); f(flags); f(material);
-    if (external_force_) {
-      f(ext_fx); f(ext_fy); f(ext_fz);
-    }
-    for (auto& a : aux) f(a);
+    for_each_field([&f](const char*, auto& v, unsigned) { f(v); });
   }
   template <class F>
   void for_each_array(F&& f) const {
     const_cast<ParticleStore*>(this)->for_each_array([&f](const auto& v) { f(v); });
   }
 
-  /// Every array, the external-force switch, the aux count and the layout
-  /// version, under `prefix` (checkpoints, core/archive.hpp).
+  /// Every field with kCheckpoint, the external-force switch, the aux count
+  /// and the layout version, under `prefix` (checkpoints, core/archive.hpp).
   void save(ArchiveWriter& w, const std::string& prefix) const;
   /// The inverse of save(); throws ConfigError when a section is missing or
   /// the arrays' lengths disagree.
@@ -147,6 +193,8 @@ struct ParticleStore {
 
  private:
   bool external_force_ = false;
+  std::vector<std::string> aux_name_;
+  std::vector<unsigned> aux_sync_;
 };
 
 }  // namespace domel::platform

@@ -93,13 +93,10 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
                      const std::filesystem::path& out) {
   fine_grid_->set_accessible(walls, 0.0);
   coarse_grid_->set_accessible(walls, 0.0);
-  std::optional<ParticleStore> all_c, all_f;
-  if (ranks_) {
-    all_c.emplace(ranks_->gather(*subdomains[spec_.coarse], true));
-    all_f.emplace(ranks_->gather(*subdomains[spec_.fine], true));
-  }
-  const ParticleStore& c = ranks_ ? *all_c : subdomains[spec_.coarse]->store();
-  const ParticleStore& f = ranks_ ? *all_f : subdomains[spec_.fine]->store();
+  const GatheredParticles all_c = ranks_->gather(*subdomains[spec_.coarse], true);
+  const GatheredParticles all_f = ranks_->gather(*subdomains[spec_.fine], true);
+  const ParticleStore& c = *all_c;
+  const ParticleStore& f = *all_f;
   const double scale = subdomains[spec_.fine]->coarse_grain() / subdomains[spec_.coarse]->coarse_grain();
   for (double r : f.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r);
   for (double r : c.radius) fine_dmax_ = std::max(fine_dmax_, 2 * r * scale);
@@ -136,21 +133,17 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
   ++since_transfer_;
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
-  // the levels' whole sets of particles: on ranks, gathered (file comment)
-  std::optional<ParticleStore> all_f, all_c;
-  if (ranks_) {
-    all_f.emplace(ranks_->gather(fine, true));
-    all_c.emplace(ranks_->gather(coarse, true));
-  }
-  ParticleStore& f = ranks_ ? *all_f : fine.store();
-  ParticleStore& c = ranks_ ? *all_c : coarse.store();
+  // the levels' whole sets of particles: on ranks, gathered (file comment);
+  // what is removed from them, each rank removes from its own
+  GatheredParticles all_f = ranks_->gather(fine, true);
+  GatheredParticles all_c = ranks_->gather(coarse, true);
+  ParticleStore& f = *all_f;
+  ParticleStore& c = *all_c;
   std::vector<std::uint64_t> gone_f = remove_escaped(f, flow), gone_c;
   count_inflow(c);
   if (spec_.match_outflow) gone_c = match_outflow(c, coarse, flow);
-  if (ranks_) {
-    remove_own(fine, std::move(gone_f));
-    remove_own(coarse, std::move(gone_c));
-  }
+  ranks_->removed(fine, std::move(gone_f));
+  ranks_->removed(coarse, std::move(gone_c));
   auto t1 = clock::now();
   timing_.count += std::chrono::duration<double>(t1 - t0).count();
   // Due at the longest interval, or earlier once what a face counted since
@@ -163,15 +156,6 @@ void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdo
   timing_.transfer += std::chrono::duration<double>(t2 - t1).count();
   control(t, interval, fine, f, coarse, c);
   timing_.control += std::chrono::duration<double>(clock::now() - t2).count();
-}
-
-void Coupling::remove_own(Subdomain& level, std::vector<std::uint64_t> ids) {
-  if (ids.empty()) return;
-  std::sort(ids.begin(), ids.end());
-  ParticleStore& s = level.particles_to_edit();
-  std::vector<std::uint8_t> mark(s.size(), 0);
-  for (std::size_t q = 0; q < s.size(); ++q) mark[q] = std::binary_search(ids.begin(), ids.end(), s.id[q]) ? 1 : 0;
-  s.remove_marked(mark);
 }
 
 std::vector<std::uint64_t> Coupling::remove_escaped(ParticleStore& s, ParticleFlow& flow) {
@@ -350,18 +334,8 @@ void Coupling::transfer(double t, Subdomain& level, ParticleStore& s, const std:
   }
   // the new particles' first half kick sees their body forces; on ranks,
   // each rank keeps those whose id falls to it
-  if (!ranks_) {
-    if (s.size() > first) level.apply_body_forces(first, s.size());
-  } else {
-    std::vector<std::uint32_t> mine;
-    for (std::size_t k = first; k < s.size(); ++k)
-      if (level.keeps(s.id[k])) mine.push_back(static_cast<std::uint32_t>(k));
-    if (!mine.empty()) {
-      ParticleStore& own = level.particles_to_edit();
-      own.append(s, mine);
-      level.apply_body_forces(own.size() - mine.size(), own.size());
-    }
-  }
+  const auto [begin, end] = ranks_->keep_added(level, s, first);
+  if (end > begin) level.apply_body_forces(begin, end);
   write_row(t, s, flow);
 }
 
@@ -521,29 +495,15 @@ void Coupling::control(double t, double interval, Subdomain& fine_level, Particl
   } catch (const PluginError& e) {
     throw RuntimeError(spec_.where + ": a controller failed at t = " + std::to_string(t) + " s: " + e.what());
   }
-  // Into the level's own particles: on one process the whole set is the
-  // store; on ranks it is the gathered set, in id order, and each rank adds
-  // the forces of its own particles, found by id.
+  // Into the level's own particles, found in the whole set (on one process
+  // the whole set is the store; on ranks the gathered set, in id order)
   auto apply = [this](Subdomain& level, const ParticleStore& whole, const Forces& f) {
-    if (!ranks_) {
-      ParticleStore& s = level.store();
-      for (std::size_t q = 0; q < s.size(); ++q) {
-        s.ext_fx[q] += f.x[q];
-        s.ext_fy[q] += f.y[q];
-        s.ext_fz[q] += f.z[q];
-      }
-      return;
-    }
+    const std::vector<std::size_t> at = ranks_->where_in_gathered(level, whole, spec_.where);
     ParticleStore& s = level.store();
-    for (std::size_t q = 0; q < level.owned(); ++q) {
-      const auto it = std::lower_bound(whole.id.begin(), whole.id.end(), s.id[q]);
-      if (it == whole.id.end() || *it != s.id[q])
-        throw RuntimeError(spec_.where + ": particle " + std::to_string(s.id[q]) + " of '" + level.name() +
-                           "' is missing from its level's gathered particles");
-      const auto k = static_cast<std::size_t>(it - whole.id.begin());
-      s.ext_fx[q] += f.x[k];
-      s.ext_fy[q] += f.y[k];
-      s.ext_fz[q] += f.z[k];
+    for (std::size_t q = 0; q < at.size(); ++q) {
+      s.ext_fx[q] += f.x[at[q]];
+      s.ext_fy[q] += f.y[at[q]];
+      s.ext_fz[q] += f.z[at[q]];
     }
   };
   apply(fine_level, fine, force_f);

@@ -42,6 +42,7 @@
 #include "loader/plugin_registry.hpp"
 #include "flow/particle_flow.hpp"
 #include "loop/macro_step.hpp"
+#include "loop/ranks.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <nlohmann/json.hpp>
@@ -135,7 +136,7 @@ class Coupling {
 
   const CouplingSpec& spec() const { return spec_; }
   /// Spread over these ranks (null: one process); before start().
-  void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
+  void set_ranks(RunRanks& ranks) { ranks_ = &ranks; }
   /// The two levels' averages on the region's cells; the run loop samples
   /// them on the steps they are due (every control interval of each level).
   CellGrid& fine_grid() { return *fine_grid_; }
@@ -212,12 +213,10 @@ class Coupling {
   void control(double t, double interval, Subdomain& fine_level, ParticleStore& fine, Subdomain& coarse_level,
                ParticleStore& coarse);
   void write_row(double t, const ParticleStore& fine, const ParticleFlow& flow);
-  /// On ranks: remove this rank's own particles of `level` whose ids are in `ids`.
-  static void remove_own(Subdomain& level, std::vector<std::uint64_t> ids);
   double shell_volume(int face) const;
 
   CouplingSpec spec_;
-  RunRanks* ranks_ = nullptr;
+  RunRanks* ranks_ = &one_process();
   std::unique_ptr<CellGrid> fine_grid_, coarse_grid_;
   std::array<FaceBalance, kFaces> faces_;
   /// parcel id -> position and mass at the last count, for the parcels near the region

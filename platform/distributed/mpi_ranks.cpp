@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <utility>
 
 namespace domel::platform {
 
@@ -50,7 +51,7 @@ nlohmann::json MpiRunRanks::traffic(const Subdomain& sd) {
 }
 
 
-ParticleStore MpiRunRanks::gather(Subdomain& sd, bool everywhere) {
+GatheredParticles MpiRunRanks::gather(Subdomain& sd, bool everywhere) {
   sd.collect_contact_counts();  // the contacts with ghosts counted at their owners too
   const ParticleStore& s = sd.store();
   std::vector<std::uint32_t> mine(sd.owned());
@@ -58,16 +59,14 @@ ParticleStore MpiRunRanks::gather(Subdomain& sd, bool everywhere) {
   std::vector<std::vector<char>> send(static_cast<std::size_t>(comm_.size()));
   send[0] = pack_particles(s, mine);
   const auto recv = everywhere ? comm_.all_gather(send[0]) : comm_.all_to_all(send);
-  ParticleStore all;
-  if (s.has_external_force()) all.enable_external_force();
-  all.add_aux(s.aux.size());
-  if (comm_.rank() != 0 && !everywhere) return all;
+  ParticleStore all = s.empty_like();
+  if (comm_.rank() != 0 && !everywhere) return GatheredParticles(std::move(all));
   for (const auto& b : recv) unpack_particles(all, b);
   std::vector<std::uint32_t> order(all.size());
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return all.id[a] < all.id[b]; });
   all.permute(order);
-  return all;
+  return GatheredParticles(std::move(all));
 }
 
 }  // namespace domel::platform

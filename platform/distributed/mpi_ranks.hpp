@@ -18,7 +18,7 @@ class MpiRunRanks final : public RunRanks {
   int rank() const override { return comm_.rank(); }
   int size() const override { return comm_.size(); }
   void distribute(Subdomain& sd, int first = 0, int count = 0) override;
-  ParticleStore gather(Subdomain& sd, bool everywhere = false) override;
+  GatheredParticles gather(Subdomain& sd, bool everywhere = false) override;
   std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) override { return comm_.all_gather(mine); }
   std::vector<std::vector<char>> gather_to_root(const std::vector<char>& mine) override {
     std::vector<std::vector<char>> send(static_cast<std::size_t>(comm_.size()));

@@ -10,19 +10,22 @@
 
 namespace domel::platform {
 
-std::size_t particle_bytes(const ParticleStore& s) {
+std::size_t particle_bytes(const ParticleStore& s, unsigned sync) {
   std::size_t b = 0;
-  s.for_each_array([&b](const auto& v) { b += sizeof(typename std::decay_t<decltype(v)>::value_type); });
+  s.for_each_field([&](const char*, const auto& v, unsigned f) {
+    if (f & sync) b += sizeof(typename std::decay_t<decltype(v)>::value_type);
+  });
   return b;
 }
 
 std::vector<char> pack_particles(const ParticleStore& s, const std::vector<std::uint32_t>& which,
-                                 const std::vector<std::array<double, 3>>* shift) {
-  std::vector<char> out(which.size() * particle_bytes(s));
+                                 const std::vector<std::array<double, 3>>* shift, unsigned sync) {
+  std::vector<char> out(which.size() * particle_bytes(s, sync));
   char* p = out.data();
   const void* position[3] = {&s.x, &s.y, &s.z};
-  // array-major within the buffer: one pass per array
-  s.for_each_array([&](const auto& v) {
+  // array-major within the buffer: one pass per field
+  s.for_each_field([&](const char*, const auto& v, unsigned f) {
+    if (!(f & sync)) return;
     using T = typename std::decay_t<decltype(v)>::value_type;
     int axis = -1;
     for (int a = 0; a < 3; ++a)
@@ -38,18 +41,19 @@ std::vector<char> pack_particles(const ParticleStore& s, const std::vector<std::
   return out;
 }
 
-void unpack_particles(ParticleStore& s, const std::vector<char>& bytes) {
-  const std::size_t per = particle_bytes(s);
-  if (bytes.size() % per != 0)
+void unpack_particles(ParticleStore& s, const std::vector<char>& bytes, unsigned sync) {
+  const std::size_t per = particle_bytes(s, sync);
+  if (per == 0 || bytes.size() % per != 0)
     throw std::runtime_error("unpack_particles: " + std::to_string(bytes.size()) + " bytes are not whole particles of " +
                              std::to_string(per) + " bytes (a store of another layout sent them)");
   const std::size_t n = bytes.size() / per;
   if (n == 0) return;
   const char* p = bytes.data();
-  s.for_each_array([&](auto& v) {
+  s.for_each_field([&](const char*, auto& v, unsigned f) {
     using T = typename std::decay_t<decltype(v)>::value_type;
     const std::size_t old = v.size();
-    v.resize(old + n);
+    v.resize(old + n);  // a field not sent: zero
+    if (!(f & sync)) return;
     std::memcpy(static_cast<void*>(v.data() + old), p, n * sizeof(T));
     p += n * sizeof(T);
   });
@@ -199,13 +203,13 @@ ExchangeCounts GhostExchange::build(ParticleStore& s, std::size_t owned, const D
         }
     }
   std::vector<std::vector<char>> send(nr);
-  for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(s, sent_[r], &shift_[r]);
+  for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(s, sent_[r], &shift_[r], ParticleStore::kGhostBuild);
   const auto recv = comm.all_to_all(send);
   const std::size_t per = particle_bytes(s);
   first_.assign(nr + 1, 0);
   for (std::size_t r = 0; r < nr; ++r) {
     first_[r] = s.size();
-    unpack_particles(s, recv[r]);
+    unpack_particles(s, recv[r], ParticleStore::kGhostBuild);
     c.received += recv[r].size() / per;
   }
   first_[nr] = s.size();
@@ -217,31 +221,55 @@ void GhostExchange::check(const ParticleStore& s, const char* what) const {
     throw std::logic_error(std::string("GhostExchange::") + what + ": no build(), or the store changed since");
 }
 
-std::size_t GhostExchange::update_bytes() const {
+namespace {
+/// The store's double fields whose sync policy has `sync`, in the table's order.
+std::vector<std::vector<double>*> double_fields(ParticleStore& s, unsigned sync) {
+  std::vector<std::vector<double>*> out;
+  s.for_each_field([&](const char* name, auto& v, unsigned f) {
+    if (!(f & sync)) return;
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::vector<double>>) out.push_back(&v);
+    else throw std::logic_error(std::string("the per-particle field '") + name + "' is not real-valued: it cannot be "
+                                "refreshed in the ghosts or summed at the owners");
+  });
+  return out;
+}
+std::vector<const std::vector<double>*> as_const(const std::vector<std::vector<double>*>& v) {
+  return {v.begin(), v.end()};
+}
+}  // namespace
+
+std::size_t GhostExchange::update_bytes(const ParticleStore& s) const {
   std::size_t n = 0;
   for (const auto& r : sent_) n += r.size();
-  return n * 9 * sizeof(double);
+  return n * particle_bytes(s, ParticleStore::kGhostUpdate);
 }
 
-std::size_t GhostExchange::reverse_bytes() const {
-  return first_.empty() ? 0 : (first_.back() - first_.front()) * 6 * sizeof(double);
+std::size_t GhostExchange::reverse_bytes(const ParticleStore& s) const {
+  return first_.empty() ? 0 : (first_.back() - first_.front()) * particle_bytes(s, ParticleStore::kReverse);
 }
 
 void GhostExchange::update(ParticleStore& s, const Communicator& comm) const {
   check(s, "update");
-  const std::vector<const std::vector<double>*> motion = {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz};
+  // the fields the ghosts follow their owners in (kGhostUpdate; positions
+  // shifted for images)
+  const std::vector<std::vector<double>*> into = double_fields(s, ParticleStore::kGhostUpdate);
+  const std::vector<const std::vector<double>*> motion = as_const(into);
+  std::size_t position[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
+  for (std::size_t f = 0; f < into.size(); ++f)
+    for (int a = 0; a < 3; ++a)
+      if (into[f] == (a == 0 ? &s.x : a == 1 ? &s.y : &s.z)) position[a] = f;
   std::vector<std::vector<char>> send(sent_.size());
   for (std::size_t r = 0; r < sent_.size(); ++r) {
     send[r] = gather_values(motion, sent_[r]);
     auto* v = reinterpret_cast<double*>(send[r].data());
     for (std::size_t q = 0; q < sent_[r].size(); ++q)
-      for (std::size_t a = 0; a < 3; ++a) v[q * motion.size() + a] += shift_[r][q][a];  // images: shifted positions
+      for (std::size_t a = 0; a < 3; ++a)
+        if (position[a] != SIZE_MAX) v[q * motion.size() + position[a]] += shift_[r][q][a];  // images: shifted
   }
   const auto recv = comm.all_to_all(send);
-  std::vector<double>* into[9] = {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz};
   for (std::size_t r = 0; r < recv.size(); ++r) {
     const std::size_t n = first_[r + 1] - first_[r];
-    if (recv[r].size() != n * std::size(into) * sizeof(double))
+    if (recv[r].size() != n * into.size() * sizeof(double))
       throw std::runtime_error("GhostExchange::update: rank " + std::to_string(r) + " sent another number of ghosts");
     const auto* p = reinterpret_cast<const double*>(recv[r].data());
     for (std::size_t g = first_[r]; g < first_[r + 1]; ++g)
@@ -251,7 +279,9 @@ void GhostExchange::update(ParticleStore& s, const Communicator& comm) const {
 
 void GhostExchange::reverse(ParticleStore& s, const Communicator& comm) const {
   check(s, "reverse");
-  const std::vector<const std::vector<double>*> loads = {&s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz};
+  // the fields the ghosts add to their owners' (kReverse: forces, torques)
+  const std::vector<std::vector<double>*> into = double_fields(s, ParticleStore::kReverse);
+  const std::vector<const std::vector<double>*> loads = as_const(into);
   const std::size_t nr = sent_.size();
   std::vector<std::vector<char>> send(nr);
   for (std::size_t r = 0; r < nr; ++r) {
@@ -260,9 +290,8 @@ void GhostExchange::reverse(ParticleStore& s, const Communicator& comm) const {
     send[r] = gather_values(loads, mine);
   }
   const auto recv = comm.all_to_all(send);
-  std::vector<double>* into[6] = {&s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz};
   for (std::size_t r = 0; r < nr; ++r) {  // in rank order: fixed sums
-    if (recv[r].size() != sent_[r].size() * std::size(into) * sizeof(double))
+    if (recv[r].size() != sent_[r].size() * into.size() * sizeof(double))
       throw std::runtime_error("GhostExchange::reverse: rank " + std::to_string(r) + " returned another number of ghosts");
     const auto* p = reinterpret_cast<const double*>(recv[r].data());
     for (std::uint32_t k : sent_[r])

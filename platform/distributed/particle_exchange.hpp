@@ -19,15 +19,18 @@
 
 namespace domel::platform {
 
-/// Bytes one particle of this store takes (every array's element).
-std::size_t particle_bytes(const ParticleStore& s);
-/// Particles `which` of s, in that order, as bytes; with `shift`, the q-th
-/// one's position moved by shift[q] (a periodic image).
+/// Bytes one particle of this store takes in a message of the fields whose
+/// sync policy has any of `sync` (ParticleStore::for_each_field).
+std::size_t particle_bytes(const ParticleStore& s, unsigned sync = ParticleStore::kMigrate);
+/// Particles `which` of s, in that order, as bytes: the fields with any of
+/// `sync` (kMigrate: a migration or a gather; kGhostBuild: new ghosts); with
+/// `shift`, the q-th one's position moved by shift[q] (a periodic image).
 std::vector<char> pack_particles(const ParticleStore& s, const std::vector<std::uint32_t>& which,
-                                 const std::vector<std::array<double, 3>>* shift = nullptr);
-/// Append the particles of `bytes` (packed from a store of the same layout:
-/// the same external-force switch and aux count) to s.
-void unpack_particles(ParticleStore& s, const std::vector<char>& bytes);
+                                 const std::vector<std::array<double, 3>>* shift = nullptr,
+                                 unsigned sync = ParticleStore::kMigrate);
+/// Append the particles of `bytes` (packed from a store of the same fields,
+/// with the same `sync`) to s; the fields not sent start at zero.
+void unpack_particles(ParticleStore& s, const std::vector<char>& bytes, unsigned sync = ParticleStore::kMigrate);
 
 /// Ids for `count` new particles of this rank (a pour, an inflow) that are
 /// unique over all ranks: rank r's block follows those of ranks 0..r-1, and
@@ -82,9 +85,9 @@ class GhostExchange {
   std::size_t owned() const { return first_.empty() ? 0 : first_.front(); }
   /// The store's size at the last build (the end of the ghosts).
   std::size_t size() const { return first_.empty() ? 0 : first_.back(); }
-  /// Bytes sent to other ranks by one update() and by one reverse().
-  std::size_t update_bytes() const;
-  std::size_t reverse_bytes() const;
+  /// Bytes sent to other ranks by one update() and by one reverse() of s.
+  std::size_t update_bytes(const ParticleStore& s) const;
+  std::size_t reverse_bytes(const ParticleStore& s) const;
   /// Checkpoints: who-went-where of the last build (what update() and
   /// reverse() read until the next build).
   void save(ArchiveWriter& w, const std::string& prefix) const;

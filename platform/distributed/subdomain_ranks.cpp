@@ -95,13 +95,13 @@ void SubdomainRanks::build_ghosts(ParticleStore& s, std::size_t owned, double cu
 void SubdomainRanks::update_ghosts(ParticleStore& s) {
   ghosts_.update(s, comm_);
   ++traffic_.updates;
-  traffic_.update_bytes += ghosts_.update_bytes();
+  traffic_.update_bytes += ghosts_.update_bytes(s);
 }
 
 void SubdomainRanks::reverse(ParticleStore& s) {
   ghosts_.reverse(s, comm_);
   ++traffic_.reverses;
-  traffic_.reverse_bytes += ghosts_.reverse_bytes();
+  traffic_.reverse_bytes += ghosts_.reverse_bytes(s);
 }
 
 SubdomainRanks& distribute(Subdomain& sd, const Communicator& comm) {

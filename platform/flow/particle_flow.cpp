@@ -100,7 +100,6 @@ double FlowSeries::slope(double t0, double t1) const {
 }
 
 std::vector<std::vector<char>> ParticleFlow::from_every_rank(const std::vector<char>& mine) const {
-  if (!ranks_) return {mine};
   return ranks_->all_gather(mine);
 }
 
@@ -109,7 +108,6 @@ std::pair<MassUnits, std::uint64_t> ParticleFlow::present(const Subdomain& sd) c
   MassUnits mass = 0;
   for (std::size_t q = 0; q < sd.owned(); ++q) mass += mass_units(s.mass[q]);
   std::uint64_t n = sd.owned();
-  if (!ranks_) return {mass, n};
   std::vector<char> mine(sizeof(MassUnits) + sizeof(n));
   std::memcpy(mine.data(), &mass, sizeof(MassUnits));
   std::memcpy(mine.data() + sizeof(MassUnits), &n, sizeof(n));
@@ -141,12 +139,10 @@ void ParticleFlow::start(std::vector<std::unique_ptr<Subdomain>>& subdomains) {
 }
 
 void ParticleFlow::update(const MacroStep& step, std::vector<std::unique_ptr<Subdomain>>& subdomains) {
-  if (ranks_) {
-    // the ghosts' contact counts go home before any rank edits its particles
-    // (an edit drops the ghosts; the outputs' gathers later in this macro
-    // step then find the counts collected). Collective, so on every rank.
-    for (auto& sd : subdomains) sd->collect_contact_counts();
-  }
+  // the ghosts' contact counts go home before any rank edits its particles
+  // (an edit drops the ghosts; the outputs' gathers later in this macro
+  // step then find the counts collected). Collective, so on every rank.
+  for (auto& sd : subdomains) sd->collect_contact_counts();
   const double t = step.t;
   if (checks_.take(step.index)) {
     check_planes(subdomains);  // count crossings before the crossed particles are deleted
@@ -187,9 +183,8 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   ++p.events;
   if (p.inserted_mass >= target) return;
   // the particles to keep clear of: all of them, on every rank when spread
-  ParticleStore everywhere;
-  if (ranks_) everywhere = ranks_->gather(sd, true);
-  const ParticleStore& present = ranks_ ? everywhere : sd.store();
+  const GatheredParticles everywhere = ranks_->gather(sd, true);
+  const ParticleStore& present = *everywhere;
   // one seed per event: the pour's seed and the event count mixed with the
   // multiplier and increment of Knuth's MMIX linear congruential generator
   const std::uint64_t seed = p.seed * 6364136223846793005ull + p.events * 1442695040888963407ull;
@@ -251,13 +246,13 @@ void ParticleFlow::check_planes(std::vector<std::unique_ptr<Subdomain>>& subdoma
   // spread over ranks, every rank watches all particles (gathered in id
   // order), so the sides and the counts are the same on every rank and a
   // particle that changed rank between two checks is still followed
-  std::vector<ParticleStore> everywhere(ranks_ ? subdomains.size() : 0);
+  std::vector<GatheredParticles> everywhere(subdomains.size());
   for (std::size_t k = 0; k < everywhere.size(); ++k) everywhere[k] = ranks_->gather(*subdomains[k], true);
   for (auto& pl : planes) {
     if (pl.side.size() != subdomains.size()) pl.side.assign(subdomains.size(), {});
     for (std::size_t k = 0; k < subdomains.size(); ++k) {
       if (pl.subdomain != kAllSubdomains && pl.subdomain != k) continue;
-      const ParticleStore& s = ranks_ ? everywhere[k] : subdomains[k]->store();
+      const ParticleStore& s = *everywhere[k];
       auto& side = pl.side[k];
       for (std::size_t q = 0; q < s.size(); ++q) {
         const double d = (s.x[q] - pl.p[0]) * pl.n[0] + (s.y[q] - pl.p[1]) * pl.n[1] + (s.z[q] - pl.p[2]) * pl.n[2];

@@ -158,13 +158,13 @@ class ParticleFlow final : public Component, public ProbeSource {
 
   bool empty() const { return pours.empty() && deletions.empty() && planes.empty() && !external_; }
 
-  /// A run spread over ranks (run_ranks.hpp): every rank keeps the same
+  /// The run's ranks (loop/ranks.hpp; spread over several): every rank keeps the same
   /// books. A pour's insertion is computed alike on every rank from all
   /// particles (the same new particles and ids for any rank count), each new
   /// particle kept by one rank; deletion regions remove each rank's own
   /// particles and the counts are summed (exactly: integers, 1e-18 kg
   /// units); the planes watch all particles. Call before start().
-  void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
+  void set_ranks(RunRanks& ranks) { ranks_ = &ranks; }
 
   /// Particles that something else (a coupling between levels) adds to or
   /// removes from subdomain k between steps: they enter the balance like a
@@ -225,7 +225,7 @@ class ParticleFlow final : public Component, public ProbeSource {
   /// Each rank's bytes on every rank (one process: its own).
   std::vector<std::vector<char>> from_every_rank(const std::vector<char>& mine) const;
 
-  RunRanks* ranks_ = nullptr;
+  RunRanks* ranks_ = &one_process();
   std::vector<MassAccount> accounts_;
   bool external_ = false;
   Cadence checks_;  ///< deletion (and plane) checks, every deletion_interval from deletion_interval on

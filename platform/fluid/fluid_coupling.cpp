@@ -72,11 +72,11 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
   std::vector<domel_fluid_drag_v1*> drag_ptrs(nl);
   std::vector<const double*> mean_ptrs(nl);
   // spread over ranks: the coupler sees every rank's particles, gathered
-  std::vector<ParticleStore> gathered(ranks_ ? nl : 0);
+  std::vector<GatheredParticles> gathered(nl);
   for (std::size_t L = 0; L < nl; ++L) {
     Subdomain& sd = *subdomains[spec_.levels[L]];
-    if (ranks_) gathered[L] = ranks_->gather(sd, true);
-    ParticleStore& s = ranks_ ? gathered[L] : sd.store();
+    gathered[L] = ranks_->gather(sd, true);
+    ParticleStore& s = *gathered[L];
     auto& x = s.aux;
     const std::size_t a = aux_[L], n = s.size();
     for (std::size_t q = kBeta; q <= kFz; ++q) std::fill(x[a + q].begin(), x[a + q].end(), 0.0);
@@ -154,18 +154,15 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
     const std::size_t a = aux_[L];
     const double dt = sd.time_step();
     const std::size_t n = sd.owned();
-    if (ranks_) {
-      // this rank's particles take their drag from the gathered copy (id order)
-      const ParticleStore& all = gathered[L];
-      for (std::size_t k = 0; k < n; ++k) {
-        const auto it = std::lower_bound(all.id.begin(), all.id.end(), s.id[k]);
-        if (it == all.id.end() || *it != s.id[k])
-          throw RuntimeError(spec_.where + ": particle id " + std::to_string(s.id[k]) + " of subdomain '" +
-                             sd.name() + "' is missing from the particles gathered for the fluid");
-        const auto g = static_cast<std::size_t>(it - all.id.begin());
-        for (std::size_t q = kBeta; q <= kFz; ++q) x[a + q][k] = all.aux[a + q][g];
-        for (std::size_t q = kSx; q <= kSt; ++q) x[a + q][k] = 0.0;
-      }
+    // this rank's particles take their drag from the whole set (on ranks a
+    // gathered copy in id order; on one process the store, where each
+    // particle already has its own)
+    const ParticleStore& all = *gathered[L];
+    const std::vector<std::size_t> at = ranks_->where_in_gathered(sd, all, spec_.where);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t g = at[k];
+      for (std::size_t q = kBeta; q <= kFz; ++q) x[a + q][k] = all.aux[a + q][g];
+      for (std::size_t q = kSx; q <= kSt; ++q) x[a + q][k] = 0.0;
     }
     std::array<double, 3> net{0, 0, 0};
     for (std::size_t k = 0; k < n; ++k) {
@@ -194,10 +191,8 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
       x[a + kLx][k] = f[0], x[a + kLy][k] = f[1], x[a + kLz][k] = f[2];
       for (int d = 0; d < 3; ++d) net[d] += f[d];
     }
-    if (ranks_) {
-      const std::vector<double> total = ranks_->sum_in_rank_order({net[0], net[1], net[2]});
-      net = {total[0], total[1], total[2]};
-    }
+    const std::vector<double> total = ranks_->sum_in_rank_order({net[0], net[1], net[2]});
+    net = {total[0], total[1], total[2]};
     net_force_[L] = net;
   }
 }
@@ -214,7 +209,7 @@ void FluidCoupling::write_fields(std::uint64_t tick, double t, bool final, const
     os << spec_.where << ": the fluid coupler's fields failed at t = " << t << " s: " << e.what();
     throw RuntimeError(os.str());
   }
-  if (ranks_ && ranks_->rank() != 0) return;  // every rank asked the coupler alike (its state); rank 0 writes
+  if (ranks_->rank() != 0) return;  // every rank asked the coupler alike (its state); rank 0 writes
   if (!fields_out_) fields_out_ = std::make_unique<io::FieldImageSeries>(out, "fluid");
   io::FieldImage image;
   image.cells = {f.nx, f.ny, f.nz};

@@ -88,7 +88,7 @@ class FluidCoupling final : public Component {
   /// (every rank's, in id order) and gives the coupler the same question, so
   /// the fluid is the same on every rank; each rank keeps its own particles'
   /// drag. Null: one process.
-  void set_ranks(RunRanks* ranks) { ranks_ = ranks; }
+  void set_ranks(RunRanks& ranks) { ranks_ = &ranks; }
 
   /// Write the coupler's fields when due at macro step `tick`, time t (or,
   /// `final`, at the end whatever the interval) into
@@ -112,7 +112,7 @@ class FluidCoupling final : public Component {
   nlohmann::json summary() const;
 
  private:
-  RunRanks* ranks_ = nullptr;
+  RunRanks* ranks_ = &one_process();
   // aux array offsets within each level's block (ParticleStore::aux)
   // beta and u; the held force; the velocity integral and its time; the
   // fluid force last applied (replaced in f at an exchange)

@@ -42,6 +42,7 @@
 #include "core/cadence.hpp"
 #include "core/particle_store.hpp"
 #include "loop/macro_step.hpp"
+#include "loop/ranks.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -74,14 +75,14 @@ struct GridSampler {
 class RunContext {
  public:
   RunContext(std::vector<std::unique_ptr<Subdomain>>& subdomains, std::vector<WallPrimitive>& walls,
-             std::filesystem::path out, RunRanks* ranks, double macro, std::uint64_t first, std::uint64_t stop,
+             std::filesystem::path out, RunRanks& ranks, double macro, std::uint64_t first, std::uint64_t stop,
              bool restart);
   ~RunContext();
 
   std::vector<std::unique_ptr<Subdomain>>& subdomains;
   std::vector<WallPrimitive>& walls;
   const std::filesystem::path out;  ///< the output folder
-  RunRanks* const ranks;            ///< the ranks a run is spread over; null: one process
+  RunRanks& ranks;                  ///< the processes the run is on (loop/ranks.hpp: one, or MPI ranks)
   const bool writer;                ///< this process writes the files (one process, or rank 0)
   const double macro;               ///< [s]
   const std::uint64_t first;        ///< the macro index the run starts at (a restart's checkpoint's)
@@ -102,7 +103,7 @@ class RunContext {
   std::vector<GridSampler>& samplers() { return samplers_; }
 
  private:
-  std::vector<ParticleStore> gathered_;
+  std::vector<GatheredParticles> gathered_;
   std::vector<double> gathered_at_;
   std::vector<GridSampler> samplers_;
 };

@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: MIT
-// What a run spread over several processes (issue 19) asks of the layer
-// that spreads it (distributed/mpi_ranks.hpp): every rank builds the same
-// scenario, keeps its share of each subdomain's particles and steps it;
-// rank 0 alone writes the outputs, from the particles gathered to it in id
-// order and from statistics summed over the ranks. Simulation::run() takes
-// one through RunOptions::ranks; without one the run is one process.
+// What a run asks of the processes it runs on (issue 19; issue 40: ranks as
+// a layer). Every run has one: SingleProcess (below) on one process, where a
+// gather is the subdomain's own store and a sum is the value itself;
+// MpiRunRanks (distributed/mpi_ranks.hpp) under mpirun, where every rank
+// builds the same scenario, keeps its share of each subdomain's particles
+// and steps it, and rank 0 alone writes the outputs, from the particles
+// gathered to it in id order and from statistics summed over the ranks. So a
+// component says what it needs once (a level's whole set of particles, a
+// sum, an edit of the whole set carried back) and runs alike on both.
 #pragma once
 
+#include "averaging/cell_grid.hpp"
 #include "core/error.hpp"
 #include "core/particle_store.hpp"
 
@@ -16,6 +20,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace domel::platform {
@@ -63,6 +69,26 @@ inline std::vector<RankGroup> rank_groups(const std::vector<double>& shares, int
   return g;
 }
 
+/// A level's whole set of particles as RunRanks::gather hands it out: on one
+/// process the subdomain's own store, not a copy (an edit of it is the
+/// level's edit); on ranks a gathered copy in id order, whose edits the ranks
+/// carry back to the owners (RunRanks::removed, keep_added,
+/// where_in_gathered).
+class GatheredParticles {
+ public:
+  GatheredParticles() = default;
+  explicit GatheredParticles(ParticleStore& own) : own_(&own) {}
+  explicit GatheredParticles(ParticleStore&& copy) : copy_(std::move(copy)) {}
+  ParticleStore& operator*() { return own_ ? *own_ : copy_; }
+  const ParticleStore& operator*() const { return own_ ? *own_ : copy_; }
+  ParticleStore* operator->() { return &**this; }
+  const ParticleStore* operator->() const { return &**this; }
+
+ private:
+  ParticleStore* own_ = nullptr;
+  ParticleStore copy_;
+};
+
 class RunRanks {
  public:
   virtual ~RunRanks() = default;
@@ -73,9 +99,29 @@ class RunRanks {
   /// holds none of sd (Subdomain::set_elsewhere). Before setup().
   /// Collective over all ranks.
   virtual void distribute(Subdomain& sd, int first = 0, int count = 0) = 0;
-  /// The particles every rank owns of sd, in id order, on rank 0 (on the
-  /// others: empty), or with `everywhere` on every rank. Collective.
-  virtual ParticleStore gather(Subdomain& sd, bool everywhere = false) = 0;
+  /// The particles every rank owns of sd: in id order, on rank 0 (on the
+  /// others: empty), or with `everywhere` on every rank; on one process the
+  /// store itself. Collective.
+  virtual GatheredParticles gather(Subdomain& sd, bool everywhere = false) = 0;
+  /// Where each particle this rank owns of sd, store()[0, owned()), sits in
+  /// `whole` (gather(sd, true)). Throws RuntimeError, naming `who`, for one
+  /// that is missing. Not collective.
+  virtual std::vector<std::size_t> where_in_gathered(Subdomain& sd, const ParticleStore& whole,
+                                                     const std::string& who);
+  /// The particles `ids` were removed from sd's gathered set (every rank
+  /// alike): each rank removes those it owns. Not collective.
+  virtual void removed(Subdomain& sd, std::vector<std::uint64_t> ids);
+  /// Particles were appended to sd's gathered set `whole` at [first,
+  /// whole.size()) (every rank alike): each rank keeps those whose id falls
+  /// to it (Subdomain::keeps). Returns where they are in sd's store, [begin,
+  /// end), for their body forces. Not collective.
+  virtual std::pair<std::size_t, std::size_t> keep_added(Subdomain& sd, const ParticleStore& whole,
+                                                         std::size_t first);
+  /// The contact records of sd's last recorded step, indexing `whole`
+  /// (gather(sd, true)): on ranks every rank's, gathered into `storage`; on
+  /// one process the subdomain's own lists. Collective.
+  virtual std::vector<const std::vector<ContactRecord>*> contact_records(Subdomain& sd, const ParticleStore& whole,
+                                                                         std::vector<ContactRecord>& storage);
   /// Every rank's bytes, on every rank, by rank. Collective.
   virtual std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) = 0;
   /// Every rank's bytes, by rank, on rank 0 (on the others: none). Collective.
@@ -97,7 +143,7 @@ class RunRanks {
   }
   /// Element-wise sums (added up in rank order) and maxima over the ranks,
   /// in place: the same bits on every rank. Collective.
-  void reduce_in_rank_order(std::vector<double>& sums, std::vector<double>& maxima) {
+  virtual void reduce_in_rank_order(std::vector<double>& sums, std::vector<double>& maxima) {
     std::vector<double> both(sums);
     both.insert(both.end(), maxima.begin(), maxima.end());
     std::vector<char> bytes(both.size() * sizeof(double));
@@ -118,9 +164,38 @@ class RunRanks {
   /// The largest x over the ranks. Collective.
   virtual double max(double x) = 0;
   /// What sd's ranks exchanged since the start, summed over the ranks (for
-  /// summary.json: particles and histories migrated, ghosts, bytes).
-  /// Collective.
+  /// summary.json: particles and histories migrated, ghosts, bytes); null
+  /// on one process. Collective.
   virtual nlohmann::json traffic(const Subdomain& sd) = 0;
 };
+
+/// The ranks of a run on one process: rank 0 of 1. A gather is the store, a
+/// sum or a maximum the value itself (bit for bit: no 0 + x), an edit of a
+/// gathered set already the level's edit.
+class SingleProcess final : public RunRanks {
+ public:
+  int rank() const override { return 0; }
+  int size() const override { return 1; }
+  void distribute(Subdomain&, int, int) override {}
+  GatheredParticles gather(Subdomain& sd, bool everywhere = false) override;
+  std::vector<std::size_t> where_in_gathered(Subdomain& sd, const ParticleStore& whole,
+                                             const std::string& who) override;
+  void removed(Subdomain&, std::vector<std::uint64_t>) override {}
+  std::pair<std::size_t, std::size_t> keep_added(Subdomain&, const ParticleStore& whole, std::size_t first) override {
+    return {first, whole.size()};
+  }
+  std::vector<const std::vector<ContactRecord>*> contact_records(Subdomain& sd, const ParticleStore& whole,
+                                                                 std::vector<ContactRecord>& storage) override;
+  std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) override { return {mine}; }
+  std::vector<std::vector<char>> gather_to_root(const std::vector<char>& mine) override { return {mine}; }
+  void sum(std::vector<std::uint64_t>&) override {}
+  void reduce_in_rank_order(std::vector<double>&, std::vector<double>&) override {}
+  double max(double x) override { return x; }
+  nlohmann::json traffic(const Subdomain&) override { return nullptr; }
+};
+
+/// A SingleProcess for components used outside a run's loop (tests, tools)
+/// until the run hands them its ranks: it holds no state, so one serves all.
+RunRanks& one_process();
 
 }  // namespace domel::platform

@@ -4,7 +4,6 @@
 
 #include "core/archive.hpp"
 #include "loop/ranks.hpp"
-#include "outputs/gathered_contacts.hpp"
 #include "subdomain/subdomain.hpp"
 
 #include <cmath>
@@ -158,10 +157,9 @@ void ContactSample::after_step(RunContext& ctx, std::size_t k, bool last) {
 
 void ContactSample::take(RunContext& ctx, std::size_t k) {
   Subdomain& sd = *ctx.subdomains[k];
-  if (!ctx.ranks) return take(k, sd, ctx.walls);
-  const ParticleStore all = ctx.ranks->gather(sd, true);
-  const std::vector<ContactRecord> records = gather_contact_records(*ctx.ranks, sd, all);
-  take(k, sd, all, {&records}, ctx.walls);
+  const GatheredParticles all = ctx.ranks.gather(sd, true);
+  std::vector<ContactRecord> gathered;
+  take(k, sd, *all, ctx.ranks.contact_records(sd, *all, gathered), ctx.walls);
 }
 
 void ContactSample::probe_columns(std::vector<std::string>& names) const {

@@ -59,7 +59,7 @@ class ContactSample final : public Component, public ProbeSource {
   void take(std::size_t k, const Subdomain& sd, const std::vector<WallPrimitive>& walls);
   /// The same from particles `s` and their contact records (a subdomain
   /// spread over ranks: every rank's particles and records, gathered;
-  /// outputs/gathered_contacts.hpp); sd gives the material pairs.
+  /// RunRanks::contact_records); sd gives the material pairs.
   void take(std::size_t k, const Subdomain& sd, const ParticleStore& s,
             const std::vector<const std::vector<ContactRecord>*>& records, const std::vector<WallPrimitive>& walls);
 

@@ -58,21 +58,24 @@ int major_of(const std::string& version) {
 
 void write_checkpoint(const std::filesystem::path& file, CheckpointWorld& sim, const LoopState& loop,
                       const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra,
-                      RunRanks* ranks) {
-  // spread over ranks: every rank's part of each subdomain, on rank 0
+                      RunRanks& ranks) {
+  // One process writes each subdomain's sections in place; spread over
+  // ranks, every rank's part of each subdomain is a nested archive, on rank 0
+  // (the one branch on the rank count here: the file's layout differs).
+  const bool in_place = ranks.size() == 1;
   std::vector<std::vector<std::vector<char>>> parts(sim.subdomains.size());
   std::vector<std::uint64_t> owned(sim.subdomains.size());
-  if (ranks) {
+  for (std::size_t k = 0; k < sim.subdomains.size(); ++k) owned[k] = sim.subdomains[k]->owned();
+  ranks.sum(owned);
+  if (!in_place) {
     for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
       ArchiveWriter part;
       sim.subdomains[k]->save(part, "");
       const std::string bytes = part.serialize("{}");
-      parts[k] = ranks->gather_to_root(std::vector<char>(bytes.begin(), bytes.end()));
-      owned[k] = sim.subdomains[k]->owned();
+      parts[k] = ranks.gather_to_root(std::vector<char>(bytes.begin(), bytes.end()));
     }
-    ranks->sum(owned);
-    if (ranks->rank() != 0) return;
   }
+  if (ranks.rank() != 0) return;
   ArchiveWriter w;
   nlohmann::json header;
   header["format"] = kFormat;
@@ -88,12 +91,12 @@ void write_checkpoint(const std::filesystem::path& file, CheckpointWorld& sim, c
   header["simulated_time_s"] = loop.time;
   header["macro_step_index"] = loop.macro_index;
   header["threads"] = loop.threads;
-  header["ranks"] = ranks ? ranks->size() : 1;
+  header["ranks"] = ranks.size();
   nlohmann::json sds = nlohmann::json::array();
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
     const Subdomain& sd = *sim.subdomains[k];
     sds.push_back({{"name", sd.name()}, {"coarse_grain", sd.coarse_grain()},
-                   {"particles", ranks ? owned[k] : sd.size()}, {"steps", sd.steps()},
+                   {"particles", owned[k]}, {"steps", sd.steps()},
                    {"time_step_s", sd.time_step()}});
   }
   header["subdomains"] = sds;
@@ -111,7 +114,7 @@ void write_checkpoint(const std::filesystem::path& file, CheckpointWorld& sim, c
   w.put(std::string("loop/reals"), std::vector<double>{loop.time});
   if (!sim.servos.empty()) sim.servos.save(w, "servos/");
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
-    if (!ranks) {
+    if (in_place) {
       sim.subdomains[k]->save(w, sd_prefix(k));
       continue;
     }
@@ -209,7 +212,7 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Checkp
   return ck;
 }
 
-bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRanks* ranks) {
+bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRanks& ranks) {
   bool same_split = true;
   const ArchiveReader& r = *ck.archive;
   // the servos' travel first: the subdomains place their walls with it
@@ -217,7 +220,7 @@ bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRan
   for (std::size_t k = 0; k < sim.subdomains.size(); ++k) {
     const std::string p = sd_prefix(k);
     const std::uint64_t written_on = r.has(p + "ranks") ? r.scalar<std::uint64_t>(p + "ranks") : 1;
-    const std::uint64_t now = ranks ? static_cast<std::uint64_t>(ranks->size()) : 1;
+    const auto now = static_cast<std::uint64_t>(ranks.size());
     if (written_on != now) {
       // another rank count: every part read, the particles shared out anew
       std::vector<std::unique_ptr<ArchiveReader>> nested;
@@ -232,11 +235,11 @@ bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRan
       same_split = false;
       continue;
     }
-    if (!ranks) {
+    if (written_on == 1) {  // one process wrote the sections in place
       same_split = sim.subdomains[k]->restore(r, p) && same_split;
       continue;
     }
-    const std::string key = p + "rank" + std::to_string(ranks->rank());
+    const std::string key = p + "rank" + std::to_string(ranks.rank());
     const ArchiveReader part(r.text(key), r.path().string() + " (section '" + key + "')");
     same_split = sim.subdomains[k]->restore(part, "") && same_split;
   }

@@ -59,13 +59,14 @@ struct CheckpointWorld {
 /// Finishes every subdomain's pending step first. `extra` adds the
 /// components' sections (Simulation::run).
 ///
-/// Spread over ranks (`ranks`), every rank calls it: each subdomain is
+/// One process writes each subdomain's sections in place. Spread over
+/// ranks (`ranks`), every rank calls it: each subdomain is
 /// written as one part per rank (that rank's own particles, ghosts, lists
 /// and exchange), gathered to rank 0, which writes the file; what every rank
 /// holds alike (the loop, the servos, the flow, `extra`) is rank 0's.
 void write_checkpoint(const std::filesystem::path& file, CheckpointWorld& sim, const LoopState& loop,
-                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra = {},
-                      RunRanks* ranks = nullptr);
+                      const PluginRegistry& registry, const std::function<void(ArchiveWriter&)>& extra,
+                      RunRanks& ranks);
 
 /// A checkpoint opened for a restart and checked against the scenario.
 struct OpenedCheckpoint {
@@ -89,6 +90,6 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& file, const Checkp
 /// count): the run then differs from the uninterrupted one by round-off.
 /// Spread over ranks, every rank restores its own part of each subdomain
 /// (a checkpoint of the same rank count: the run goes on bit for bit).
-bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRanks* ranks = nullptr);
+bool restore_checkpoint(const OpenedCheckpoint& ck, CheckpointWorld& sim, RunRanks& ranks);
 
 }  // namespace domel::platform

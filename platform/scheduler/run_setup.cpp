@@ -29,24 +29,24 @@ std::string iso_time_now() {
 
 }  // namespace
 
-std::vector<RankGroup> Simulation::rank_groups_checked(RunRanks* ranks) const {
-  if (!ranks) {
+std::vector<RankGroup> Simulation::rank_groups_checked(RunRanks& ranks) const {
+  if (ranks.size() == 1) {  // rank groups share out ranks: there are none to share
     if (!rank_shares.empty()) spdlog::info("one process: the subdomains' rank_share apply to runs under mpirun only");
     return {};
   }
   if (rank_shares.empty()) return {};
   // levels on rank groups (subdomains[].rank_share), checked before anything is written
-  if (static_cast<std::size_t>(ranks->size()) < subdomains.size())
+  if (static_cast<std::size_t>(ranks.size()) < subdomains.size())
     throw ConfigError({Diagnostic{scenario_file.string(), "/subdomains/0/rank_share",
                                   "the subdomains run on rank groups of their own (rank_share), which needs a rank "
                                   "for each of the " + std::to_string(subdomains.size()) + " subdomains; mpirun "
-                                  "started " + std::to_string(ranks->size()),
+                                  "started " + std::to_string(ranks.size()),
                                   "run on at least " + std::to_string(subdomains.size()) + " ranks (mpirun -np " +
                                       std::to_string(subdomains.size()) + "), or remove every rank_share"}});
-  return rank_groups(rank_shares, ranks->size());
+  return rank_groups(rank_shares, ranks.size());
 }
 
-std::vector<int> Simulation::prepare_levels(RunRanks* ranks, const std::vector<RankGroup>& groups, int threads_n,
+std::vector<int> Simulation::prepare_levels(RunRanks& ranks, const std::vector<RankGroup>& groups, int threads_n,
                                             bool writer) {
   // Multi-rate: the macro step is the largest subdomain step; finer subdomains
   // sub-cycle with dt_k = macro / n_k (n_k rounded up, so no step grows).
@@ -62,12 +62,11 @@ std::vector<int> Simulation::prepare_levels(RunRanks* ranks, const std::vector<R
     }
     substeps.push_back(n);
     sd.set_threads(threads_n);
-    if (!ranks) continue;
     if (groups.empty()) {
-      ranks->distribute(sd);
+      ranks.distribute(sd);
       continue;
     }
-    ranks->distribute(sd, groups[k].first, groups[k].count);
+    ranks.distribute(sd, groups[k].first, groups[k].count);
     if (writer)
       spdlog::info("subdomain '{}' on rank{} {}{}", sd.name(), groups[k].count > 1 ? "s" : "", groups[k].first,
                    groups[k].count > 1 ? "-" + std::to_string(groups[k].first + groups[k].count - 1) : "");
@@ -75,8 +74,8 @@ std::vector<int> Simulation::prepare_levels(RunRanks* ranks, const std::vector<R
   return substeps;
 }
 
-void Simulation::restore_world(const OpenedCheckpoint& ck, RunRanks* ranks, int threads_n, bool writer) {
-  const int ranks_now = ranks ? ranks->size() : 1;
+void Simulation::restore_world(const OpenedCheckpoint& ck, RunRanks& ranks, int threads_n, bool writer) {
+  const int ranks_now = ranks.size();
   CheckpointWorld w = world();
   if (ck.loop.ranks != ranks_now) {
     if (writer)
@@ -95,7 +94,7 @@ void Simulation::restore_world(const OpenedCheckpoint& ck, RunRanks* ranks, int 
 nlohmann::json Simulation::summary(RunContext& ctx, const RunResult& result, const RunOptions&,
                                    const PluginRegistry& registry, const std::vector<RankGroup>& groups,
                                    int threads_n, std::size_t particles_at_start) const {
-  RunRanks* const ranks = ctx.ranks;
+  RunRanks& ranks = ctx.ranks;
   nlohmann::json summary;
   summary["domel_version"] = DOMEL_VERSION;
   summary["sdk_abi"] = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_string(DOMEL_ABI_MINOR);
@@ -107,14 +106,14 @@ nlohmann::json Simulation::summary(RunContext& ctx, const RunResult& result, con
                                                            : std::to_string(result.interrupted_by);
   summary["finished"] = iso_time_now();
   summary["threads"] = threads_n;
-  summary["ranks"] = ranks ? ranks->size() : 1;
+  summary["ranks"] = ranks.size();
   summary["seed"] = seed;
   summary["steps"] = result.macro_steps;
   summary["simulated_time_s"] = result.simulated_time;
   summary["wall_time_s"] = result.wall_seconds;
   std::size_t particles = 0;
   for (const auto& sd : subdomains) particles += sd->owned();
-  summary["particles"] = ranks ? ranks->sum_count(particles) : particles;
+  summary["particles"] = ranks.sum_count(particles);
   summary["particles_at_start"] = particles_at_start;
   summary["particle_steps_per_s"] = result.particle_steps_per_second;
   {
@@ -133,14 +132,14 @@ nlohmann::json Simulation::summary(RunContext& ctx, const RunResult& result, con
   for (std::size_t k = 0; k < subdomains.size(); ++k) {
     const auto& sd = subdomains[k];
     const SubdomainStats st = ctx.stats(k, result.simulated_time);
-    const nlohmann::json traffic = ranks ? ranks->traffic(*sd) : nlohmann::json();
+    const nlohmann::json traffic = ranks.traffic(*sd);  // null on one process
     // the same on every rank of the subdomain's group, none elsewhere
     const auto builds = static_cast<std::uint64_t>(
-        ranks ? ranks->max(static_cast<double>(sd->neighbor_builds())) : static_cast<double>(sd->neighbor_builds()));
+        ranks.max(static_cast<double>(sd->neighbor_builds())));
     MemoryUse mem = sd->memory_use();
-    if (ranks) {  // over all ranks
+    {  // over all ranks
       std::vector<std::uint64_t> b{mem.particles, mem.neighbor_lists, mem.contact_history, mem.threads};
-      ranks->sum(b);
+      ranks.sum(b);
       mem.particles = static_cast<std::size_t>(b[0]);
       mem.neighbor_lists = static_cast<std::size_t>(b[1]);
       mem.contact_history = static_cast<std::size_t>(b[2]);
@@ -168,7 +167,7 @@ nlohmann::json Simulation::summary(RunContext& ctx, const RunResult& result, con
                               {"max_overlap_ratio", st.max_overlap_ratio},
                               {"contacts", st.contacts},
                               {"wall_contacts", st.wall_contacts}}}});
-    if (ranks) sds.back()["ranks_exchange"] = traffic;
+    if (!traffic.is_null()) sds.back()["ranks_exchange"] = traffic;
     if (!groups.empty()) sds.back()["rank_group"] = {{"first", groups[k].first}, {"count", groups[k].count}};
   }
   summary["subdomains"] = sds;

@@ -9,7 +9,7 @@
 
 namespace domel::platform {
 
-void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains, RunRanks* ranks) {
+void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains, RunRanks& ranks) {
   std::vector<double> load(3 * servos.size(), 0.0);  // on this rank's particles
   for (std::size_t k = 0; k < servos.size(); ++k)
     for (const auto& sd : subdomains) {
@@ -17,7 +17,7 @@ void WallServos::update(double t, const std::vector<std::unique_ptr<Subdomain>>&
       sd->wall_load(servos[k].wall, g);
       for (int a = 0; a < 3; ++a) load[3 * k + a] += g[a];
     }
-  if (ranks) load = ranks->sum_in_rank_order(load);
+  load = ranks.sum_in_rank_order(load);
   for (std::size_t k = 0; k < servos.size(); ++k) {
     WallServo& s = servos[k];
     const double* f = &load[3 * k];

@@ -59,7 +59,7 @@ class WallServos final : public Component, public ProbeSource {
   bool empty() const { return servos.empty(); }
   /// After a macro step ending at t: measure and set the velocities. Spread
   /// over ranks, the loads are summed over them (every rank moves the wall alike).
-  void update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains, RunRanks* ranks = nullptr);
+  void update(double t, const std::vector<std::unique_ptr<Subdomain>>& subdomains, RunRanks& ranks);
   /// probes.csv: <name>.servo_force [N] (F at the last update) and <name>.servo_travel [m] (along the direction).
   std::vector<std::string> columns() const;
   void append_values(double t, std::vector<double>& row) const;

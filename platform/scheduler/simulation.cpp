@@ -102,14 +102,12 @@ void step_level(RunContext& ctx, std::size_t k, bool last, const std::vector<Com
   sd.step_deferred();  // finished by the next step or by the first observer (store(), stats())
   if (record) {
     const CellGrid::RankReduction reduce = [&](std::vector<double>& sums, std::vector<double>& maxima) {
-      ctx.ranks->reduce_in_rank_order(sums, maxima);
+      ctx.ranks.reduce_in_rank_order(sums, maxima);
     };
-    const auto records = ctx.ranks ? std::vector<const std::vector<ContactRecord>*>() : sd.contact_records();
     for (const auto& s : ctx.samplers()) {
       if (s.subdomain != k || !s.grid->due(sd.steps())) continue;
       const auto t0 = std::chrono::steady_clock::now();
-      if (ctx.ranks) s.grid->sample(sd.store(), sd.owned(), sd.contact_records(), sd.time(), reduce);
-      else s.grid->sample(sd.store(), records, sd.time());
+      s.grid->sample(sd.store(), sd.owned(), sd.contact_records(), sd.time(), reduce);
       if (s.seconds) *s.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
   }
@@ -123,8 +121,8 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   RunResult result;
   // Spread over ranks: every rank runs this function on the same scenario;
   // rank 0 alone writes files and reports (loop/ranks.hpp).
-  RunRanks* const ranks = options.ranks && options.ranks->size() > 1 ? options.ranks : nullptr;
-  const bool writer = ranks == nullptr || ranks->rank() == 0;
+  RunRanks& ranks = options.ranks && options.ranks->size() > 1 ? *options.ranks : one_process();
+  const bool writer = ranks.rank() == 0;
   const std::vector<RankGroup> groups = rank_groups_checked(ranks);
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
   result.output_directory = out;
@@ -182,12 +180,12 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   };
   std::size_t particles = 0;
   for (const auto& sd : subdomains) particles += sd->owned();
-  if (ranks) particles = ranks->sum_count(particles);
+  particles = ranks.sum_count(particles);
   if (writer)
     spdlog::info("running '{}': {} particles in {} subdomain(s), {:.6g} s simulated in {} macro steps of {:.4g} s, "
                  "{} thread(s){} -> {}",
                  name, particles, subdomains.size(), duration, total_macro, macro, threads_n,
-                 ranks ? " on each of " + std::to_string(ranks->size()) + " ranks" : std::string(), out.string());
+                 ranks.size() > 1 ? " on each of " + std::to_string(ranks.size()) + " ranks" : std::string(), out.string());
 
   // The loop.
   const auto before_macro = at_point(components, Component::kBeforeMacro);
@@ -208,7 +206,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     if (m > first && checkpoints_possible && (checkpoints.take(m) || (m == stop && checkpoint_interval > 0)))
       save_checkpoint(m);
     result.interrupted_by = m < stop ? interrupt_requested() : 0;
-    if (ranks && m < stop && ranks->sum_count(static_cast<std::size_t>(result.interrupted_by)) != 0 &&
+    if (m < stop && ranks.sum_count(static_cast<std::size_t>(result.interrupted_by)) != 0 &&
         result.interrupted_by == 0)
       result.interrupted_by = SIGTERM;  // every rank stops at the same macro step: the first signal any rank saw
     if (result.interrupted_by != 0) {
@@ -241,11 +239,9 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   const auto end = std::chrono::steady_clock::now();
   const double wall = std::chrono::duration<double>(end - progress.start).count();
   if (progress.on && progress.tty) std::fprintf(stderr, "\n");
-  if (ranks) {
-    // every rank's particle-steps (rank 0's progress line counted its own)
-    particle_steps = static_cast<double>(ranks->sum_count(static_cast<std::size_t>(particle_steps)));
-    window_particle_steps = static_cast<double>(ranks->sum_count(static_cast<std::size_t>(window_particle_steps)));
-  }
+  // every rank's particle-steps (rank 0's progress line counted its own)
+  particle_steps = static_cast<double>(ranks.sum_count(static_cast<std::size_t>(particle_steps)));
+  window_particle_steps = static_cast<double>(ranks.sum_count(static_cast<std::size_t>(window_particle_steps)));
   result.macro_steps = m;
   result.simulated_time = static_cast<double>(m) * macro;
   result.wall_seconds = wall;

@@ -139,9 +139,9 @@ class Simulation {
   /// run()'s helpers (run_setup.cpp): the rank groups, checked; the levels'
   /// time steps, threads and ranks (the sub-steps of each); the world
   /// restored from a checkpoint; the summary.
-  std::vector<RankGroup> rank_groups_checked(RunRanks* ranks) const;
-  std::vector<int> prepare_levels(RunRanks* ranks, const std::vector<RankGroup>& groups, int threads, bool writer);
-  void restore_world(const OpenedCheckpoint& ck, RunRanks* ranks, int threads, bool writer);
+  std::vector<RankGroup> rank_groups_checked(RunRanks& ranks) const;
+  std::vector<int> prepare_levels(RunRanks& ranks, const std::vector<RankGroup>& groups, int threads, bool writer);
+  void restore_world(const OpenedCheckpoint& ck, RunRanks& ranks, int threads, bool writer);
   nlohmann::json summary(RunContext& ctx, const RunResult& result, const RunOptions& options,
                          const PluginRegistry& registry, const std::vector<RankGroup>& groups, int threads,
                          std::size_t particles_at_start) const;

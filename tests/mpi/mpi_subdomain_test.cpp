@@ -9,6 +9,7 @@
 // moves to another rank (or a pair computed twice, or a ghost force not sent
 // home) changes a force by its whole tangential part at once, which is
 // orders of magnitude above it.
+#include "core/archive.hpp"
 #include "distributed/communicator.hpp"
 #include "distributed/subdomain_ranks.hpp"
 #include "support/fixture.hpp"
@@ -252,4 +253,105 @@ TEST(MpiSubdomain, AHeadOnCollisionAcrossARankBorderReboundsWithTheRestitution) 
   EXPECT_NEAR(spread, one, 1e-12 * one);
   EXPECT_NEAR(spread, 0.5, 0.005);
   if (comm.rank() == 0) std::printf("restitution on %d rank(s): %.15g (one process %.15g)\n", comm.size(), spread, one);
+}
+
+namespace {
+
+/// The value the owners of particle `id` hold in the test's field after
+/// `step` steps: distinct per particle and per step.
+double tag_value(std::uint64_t id, std::uint64_t step) {
+  return 1.0 + 0.5 * static_cast<double>(id) + 1000.0 * static_cast<double>(step);
+}
+
+/// The gas of gas(), stirred, with one field added by a test in one place
+/// (ParticleStore::add_field: carried, and refreshed in the ghosts every
+/// step), spread over the ranks of `comm`. The field is set from the id.
+Run gas_with_a_tag(const dp::Communicator& comm, std::size_t& tag) {
+  Run r{dt::build(gas())};
+  dp::Subdomain& sd = r.sd();
+  dp::ParticleStore& s = sd.store();
+  tag = s.add_field("test_tag", dp::ParticleStore::kCarried | dp::ParticleStore::kGhostUpdate);
+  stir(s);
+  for (std::size_t k = 0; k < s.size(); ++k) s.aux[tag][k] = tag_value(s.id[k], 0);
+  sd.set_skin(0.3 * kD);
+  std::vector<std::uint8_t> other(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) other[k] = !dp::starts_on_rank(s.id[k], comm.rank(), comm.size());
+  s.remove_marked(other);
+  r.ranks = &dp::distribute(sd, comm);
+  return r;
+}
+
+/// Particles of this rank whose field is not tag_value(id, step): owned and
+/// ghosts (a ghost holds its owner's value).
+std::pair<std::size_t, std::size_t> wrong_tags(dp::Subdomain& sd, std::size_t tag, std::uint64_t step) {
+  const dp::ParticleStore& s = sd.store();
+  std::size_t owned = 0, ghosts = 0;
+  for (std::size_t k = 0; k < s.size(); ++k)
+    if (s.aux[tag][k] != tag_value(s.id[k], step)) ++(k < sd.owned() ? owned : ghosts);
+  return {owned, ghosts};
+}
+
+}  // namespace
+
+// Issue 40: a per-particle field is declared once, with its sync policy, and
+// the ranks carry it as they carry the built-in fields. 400 steps of the
+// gas (under a second on 3 ranks): particles migrate at the builds, the ghosts
+// are rebuilt and refreshed between builds, and a checkpoint taken half way
+// restores the field on every rank, owners and ghosts, after which the run
+// goes on exactly as the uninterrupted one.
+TEST(MpiSubdomain, AFieldAddedInOnePlaceMigratesReachesTheGhostsAndSurvivesARestart) {
+  const dp::Communicator comm = dp::Communicator::world();
+  std::size_t tag = 0;
+  auto run = gas_with_a_tag(comm, tag);
+  dp::Subdomain& sd = run.sd();
+  sd.setup();
+  constexpr std::uint64_t kSteps = 200;
+  std::string saved;
+  for (std::uint64_t step = 1; step <= 2 * kSteps; ++step) {
+    // the owners change their value before the step; after it, owners and
+    // ghosts hold the new one (a ghost built at a list build, or refreshed)
+    dp::ParticleStore& s = sd.store();
+    for (std::size_t k = 0; k < sd.owned(); ++k) s.aux[tag][k] = tag_value(s.id[k], step);
+    sd.step();
+    const auto [owned, ghosts] = wrong_tags(sd, tag, step);
+    ASSERT_EQ(owned, 0u) << "rank " << comm.rank() << ", step " << step << ": owned particles lost their field";
+    ASSERT_EQ(ghosts, 0u) << "rank " << comm.rank() << ", step " << step << ": ghosts do not hold their owners' field";
+    if (step == kSteps) {
+      dp::ArchiveWriter w;
+      sd.save(w, "");
+      saved = w.serialize("{}");
+    }
+  }
+  // the check has something to check: particles migrated, ghosts were built
+  const dp::RankTraffic& t = run.ranks->traffic();
+  std::vector<std::uint64_t> moved{t.migrated, t.ghosts, t.updates};
+  comm.sum(moved);
+  if (comm.size() > 1) EXPECT_GT(moved[0], 0u);  // on one rank nothing migrates
+  EXPECT_GT(moved[1], 0u);  // on one rank too: the periodic images
+  EXPECT_GT(moved[2], 0u);
+
+  // the restart: a fresh subdomain with the same field, restored from the
+  // checkpoint of step kSteps, holds the field as the run did then, and the
+  // second half gives the same particles and fields bit for bit
+  std::size_t tag2 = 0;
+  auto again = gas_with_a_tag(comm, tag2);
+  dp::Subdomain& sd2 = again.sd();
+  ASSERT_TRUE(sd2.restore(dp::ArchiveReader(saved, "checkpoint part"), ""));
+  {
+    const auto [owned, ghosts] = wrong_tags(sd2, tag2, kSteps);
+    EXPECT_EQ(owned, 0u) << "rank " << comm.rank() << ": the restored owners lost their field";
+    EXPECT_EQ(ghosts, 0u) << "rank " << comm.rank() << ": the restored ghosts lost their owners' field";
+  }
+  for (std::uint64_t step = kSteps + 1; step <= 2 * kSteps; ++step) {
+    dp::ParticleStore& s = sd2.store();
+    for (std::size_t k = 0; k < sd2.owned(); ++k) s.aux[tag2][k] = tag_value(s.id[k], step);
+    sd2.step();
+  }
+  const dp::ParticleStore& a = sd.store();
+  const dp::ParticleStore& b = sd2.store();
+  ASSERT_EQ(sd.owned(), sd2.owned());
+  std::size_t differ = 0;
+  for (std::size_t k = 0; k < sd.owned(); ++k)
+    differ += a.id[k] != b.id[k] || a.x[k] != b.x[k] || a.vx[k] != b.vx[k] || a.aux[tag][k] != b.aux[tag2][k];
+  EXPECT_EQ(differ, 0u) << "rank " << comm.rank() << ": the restarted run differs from the uninterrupted one";
 }

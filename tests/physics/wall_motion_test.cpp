@@ -9,6 +9,7 @@
 //    carries the target force, and the floor then carries target + weight;
 //  - a free particle under a gravity table or a turning gravity vector
 //    follows v = integral of g dt.
+#include "loop/ranks.hpp"
 #include "support/fixture.hpp"
 
 #include <gtest/gtest.h>
@@ -79,9 +80,10 @@ TEST(ServoWall, ALidComesToRestWhereItCarriesTheTargetForce) {
   ASSERT_EQ(sim->servos.servos.size(), 1u);
   auto& sd = dt::one_sphere(*sim, {0, 0, kR}, kR, kRho);
   auto& s = sd.store();
+  domel::platform::SingleProcess one_process;
   while (sd.time() < 0.03) {
     sd.step();
-    sim->servos.update(sd.time(), sim->subdomains);  // what the run loop does after every macro step
+    sim->servos.update(sd.time(), sim->subdomains, one_process);  // what the run loop does after every macro step
   }
   double lid[3];
   sd.wall_load(1, lid);
