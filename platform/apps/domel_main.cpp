@@ -214,7 +214,7 @@ int cmd_run(int argc, char** argv) {
   if (world().rank() != 0) spdlog::set_level(spdlog::level::err);
   dp::RunOptions opt;
   std::unique_ptr<dp::MpiRunRanks> ranks;
-  if (world().size() > 1) {
+  if (world().size() > 1) {  // under mpirun; one process runs alone (RunOptions' default)
     ranks = std::make_unique<dp::MpiRunRanks>(world());
     opt.ranks = ranks.get();
   }

@@ -137,7 +137,7 @@ void CellGrid::set_accessible(const std::vector<WallPrimitive>& walls, double ti
 
 void CellGrid::sample(const ParticleStore& s, const std::vector<const std::vector<ContactRecord>*>& records,
                       double time) {
-  sample(s, s.size(), records, time, {});
+  sample(s, s.size(), records, time, [](std::vector<double>&, std::vector<double>&) {});  // one process: nothing to add
 }
 
 void CellGrid::sample(const ParticleStore& s, std::size_t owned,
@@ -189,9 +189,9 @@ void CellGrid::sample(const ParticleStore& s, std::size_t owned,
     f.vy[c] += s.mass[k] * s.vy[k];
     f.vz[c] += s.mass[k] * s.vz[k];
   }
-  if (over_ranks) {
-    // every rank's sums, and its extreme velocities (a cell without mobile
-    // particles here: none, -inf), then the sample goes on alike everywhere
+  // every rank's sums, and its extreme velocities (a cell without mobile
+  // particles here: none, -inf), then the sample goes on alike everywhere
+  {
     std::vector<double> sums, maxima;
     sums.reserve(8 * n_cells_);
     maxima.reserve(6 * n_cells_);
@@ -262,7 +262,7 @@ void CellGrid::sample(const ParticleStore& s, std::size_t owned,
     }
   }
 
-  if (over_ranks) {
+  {  // every rank's stresses
     std::vector<double> sums(f.stress_kinetic), none;
     sums.insert(sums.end(), f.stress.begin(), f.stress.end());
     over_ranks(sums, none);

@@ -17,6 +17,7 @@ class MpiRunRanks final : public RunRanks {
   explicit MpiRunRanks(Communicator comm) : comm_(std::move(comm)) {}
   int rank() const override { return comm_.rank(); }
   int size() const override { return comm_.size(); }
+  std::string on_each() const override { return " on each of " + std::to_string(comm_.size()) + " ranks"; }
   void distribute(Subdomain& sd, int first = 0, int count = 0) override;
   GatheredParticles gather(Subdomain& sd, bool everywhere = false) override;
   std::vector<std::vector<char>> all_gather(const std::vector<char>& mine) override { return comm_.all_gather(mine); }

@@ -68,9 +68,14 @@ void SubdomainRanks::save(ArchiveWriter& w, const std::string& p) const {
   save_fields(w, p + "traffic/", [&](CheckpointFields& f) { const_cast<SubdomainRanks*>(this)->traffic_fields(f); });
 }
 
-void SubdomainRanks::load(const ArchiveReader& r, const std::string& p) {
+void SubdomainRanks::load(const ArchiveReader& r, const std::string& p, std::size_t owned, std::size_t ghosts_end) {
   ghosts_.load(r, p + "ghosts/", comm_.size());
   load_fields(r, p + "traffic/", [&](CheckpointFields& f) { traffic_fields(f); });
+  // the ghosts of the last build sit after the part's own particles; a part
+  // without ghosts may have had particles added since that build
+  const bool placed = ghosts_.owned() == owned && ghosts_.size() == ghosts_end;
+  const bool none = ghosts_end == owned && ghosts_.size() == ghosts_.owned();
+  if (!placed && !none) r.fail(p + "ghosts/first", "does not place the ghosts after the rank's own particles");
 }
 
 void SubdomainRanks::traffic_fields(CheckpointFields& f) {
@@ -86,8 +91,10 @@ void SubdomainRanks::traffic_fields(CheckpointFields& f) {
   f("reverse_bytes", t.reverse_bytes);
 }
 
-void SubdomainRanks::build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) {
-  const ExchangeCounts c = ghosts_.build(s, owned, d_, cutoff, comm_, box_);
+void SubdomainRanks::build_ghosts(ParticleStore& s, std::size_t owned, double skin) {
+  double rmax = 0.0;
+  for (std::size_t k = 0; k < owned; ++k) rmax = std::max(rmax, s.radius[k]);
+  const ExchangeCounts c = ghosts_.build(s, owned, d_, 2.0 * max(rmax) + skin, comm_, box_);
   ++traffic_.ghost_builds;
   traffic_.ghosts += c.received;
 }

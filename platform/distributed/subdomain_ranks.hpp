@@ -35,22 +35,22 @@ struct RankTraffic {
 class SubdomainRanks final : public RankExchange {
  public:
   SubdomainRanks(Communicator comm, const PeriodicBox& box);
+  bool over_ranks() const override { return true; }
+  PeriodicBox pair_box(const PeriodicBox&) const override { return {}; }
   void any(bool* flags, std::size_t n) override;
   double max(double x) override;
   std::size_t migrate(ParticleStore& s, std::size_t owned, const std::vector<std::uint64_t>& cost,
                       const std::vector<PairHistories*>& histories) override;
-  void build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) override;
+  void build_ghosts(ParticleStore& s, std::size_t owned, double skin) override;
   void update_ghosts(ParticleStore& s) override;
   void reverse(ParticleStore& s) override;
   void reverse_counts(ParticleStore& s) override { ghosts_.reverse_counts(s, comm_); }
   int rank() const override { return comm_.rank(); }
   int size() const override { return comm_.size(); }
   void save(ArchiveWriter& w, const std::string& prefix) const override;
-  void load(const ArchiveReader& r, const std::string& prefix) override;
+  void load(const ArchiveReader& r, const std::string& prefix, std::size_t owned, std::size_t ghosts_end) override;
   /// The traffic counters in a checkpoint, both directions (core/archive.hpp).
   void traffic_fields(CheckpointFields& f);
-  std::size_t ghosts_begin() const override { return ghosts_.owned(); }
-  std::size_t ghosts_end() const override { return ghosts_.size(); }
 
   const Communicator& communicator() const { return comm_; }
   const Decomposition& decomposition() const { return d_; }

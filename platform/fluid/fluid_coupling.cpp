@@ -266,7 +266,7 @@ void FluidCoupling::fields(CheckpointFields& f, const std::filesystem::path& out
     for (int d = 0; d < 3; ++d) net_force_[L][d] = net[3 * L + d];
   last_limits_.solver_iterations = static_cast<uint32_t>(iterations);
   fields_.resume(fields_written);
-  if (!times.empty() && (!ranks_ || ranks_->rank() == 0)) {  // rank 0 writes the fields
+  if (!times.empty() && ranks_->rank() == 0) {  // rank 0 writes the fields
     fields_out_ = std::make_unique<io::FieldImageSeries>(out, "fluid");
     fields_out_->resume(times);
   }

@@ -94,6 +94,8 @@ class RunRanks {
   virtual ~RunRanks() = default;
   virtual int rank() const = 0;
   virtual int size() const = 0;
+  /// For the log: " on each of N ranks", or nothing on one process.
+  virtual std::string on_each() const = 0;
   /// Keep this rank's share of sd's particles and spread sd over the ranks
   /// [first, first + count) (count 0: all ranks); a rank outside the group
   /// holds none of sd (Subdomain::set_elsewhere). Before setup().
@@ -176,6 +178,7 @@ class SingleProcess final : public RunRanks {
  public:
   int rank() const override { return 0; }
   int size() const override { return 1; }
+  std::string on_each() const override { return {}; }
   void distribute(Subdomain&, int, int) override {}
   GatheredParticles gather(Subdomain& sd, bool everywhere = false) override;
   std::vector<std::size_t> where_in_gathered(Subdomain& sd, const ParticleStore& whole,

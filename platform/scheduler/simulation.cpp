@@ -121,7 +121,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   RunResult result;
   // Spread over ranks: every rank runs this function on the same scenario;
   // rank 0 alone writes files and reports (loop/ranks.hpp).
-  RunRanks& ranks = options.ranks && options.ranks->size() > 1 ? *options.ranks : one_process();
+  RunRanks& ranks = *options.ranks;
   const bool writer = ranks.rank() == 0;
   const std::vector<RankGroup> groups = rank_groups_checked(ranks);
   const std::filesystem::path out = options.output_directory.empty() ? output_directory : options.output_directory;
@@ -185,7 +185,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
     spdlog::info("running '{}': {} particles in {} subdomain(s), {:.6g} s simulated in {} macro steps of {:.4g} s, "
                  "{} thread(s){} -> {}",
                  name, particles, subdomains.size(), duration, total_macro, macro, threads_n,
-                 ranks.size() > 1 ? " on each of " + std::to_string(ranks.size()) + " ranks" : std::string(), out.string());
+                 ranks.on_each(), out.string());
 
   // The loop.
   const auto before_macro = at_point(components, Component::kBeforeMacro);

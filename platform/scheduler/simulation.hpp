@@ -44,9 +44,9 @@ struct RunOptions {
   std::uint64_t time_after = 0;            ///< benchmarks: also time the steps after this many (warm-up excluded)
   std::filesystem::path restart;           ///< a checkpoint to continue from (docs/checkpoint.md)
   bool checkpoint_on_signal = true;        ///< on SIGINT/SIGTERM (core/interrupt.hpp), write a checkpoint
-  /// A run spread over several processes (loop/ranks.hpp); null or
-  /// one rank: this process alone.
-  RunRanks* ranks = nullptr;
+  /// The processes the run is spread over (loop/ranks.hpp), never null:
+  /// this process alone unless the launcher runs under mpirun.
+  RunRanks* ranks = &one_process();
 };
 
 struct RunResult {

@@ -8,6 +8,8 @@
 // contact history lives there. The subdomain calls these at the phases of
 // its step (step_phases.hpp): migrate at exchange, build_ghosts before the
 // list build, update_ghosts at ghost_update, reverse at reverse_exchange.
+// A subdomain of one process holds a OneProcessExchange: no ghosts, every
+// collective a no-op, so the step calls the same phases either way.
 #pragma once
 
 #include "core/archive.hpp"
@@ -31,6 +33,12 @@ inline bool starts_on_rank(std::uint64_t id, int rank, int ranks) {
 class RankExchange {
  public:
   virtual ~RankExchange() = default;
+  /// Whether the subdomain is spread over ranks (a communicator of one rank
+  /// counts: its periodic images are ghosts and its step goes in phase order).
+  virtual bool over_ranks() const = 0;
+  /// The box in which pairs measure their separations: one process, the
+  /// periodic box (nearest images); over ranks, none (the images are ghosts).
+  virtual PeriodicBox pair_box(const PeriodicBox& box) const = 0;
   /// Element-wise OR of flags[0, n) over the ranks. Collective.
   virtual void any(bool* flags, std::size_t n) = 0;
   /// The largest x over the ranks. Collective.
@@ -43,8 +51,10 @@ class RankExchange {
   /// owned count. Collective.
   virtual std::size_t migrate(ParticleStore& s, std::size_t owned, const std::vector<std::uint64_t>& cost,
                               const std::vector<PairHistories*>& histories) = 0;
-  /// Append the ghosts within `cutoff` of this rank's region. Collective.
-  virtual void build_ghosts(ParticleStore& s, std::size_t owned, double cutoff) = 0;
+  /// Append the ghosts: every particle that can meet one of s[0, owned)
+  /// before the next build (cut-off: the largest diameter on any rank plus
+  /// the `skin`). Collective.
+  virtual void build_ghosts(ParticleStore& s, std::size_t owned, double skin) = 0;
   /// The owners' motion into their ghosts. Collective.
   virtual void update_ghosts(ParticleStore& s) = 0;
   /// The ghosts' forces and torques added to their owners'. Collective.
@@ -57,10 +67,34 @@ class RankExchange {
   /// Checkpoints: what the steps until the next build read (who holds
   /// which ghosts) and the traffic counted so far. Not collective.
   virtual void save(ArchiveWriter& w, const std::string& prefix) const = 0;
-  virtual void load(const ArchiveReader& r, const std::string& prefix) = 0;
-  /// Where the ghosts of the last build start and end in the store.
-  virtual std::size_t ghosts_begin() const = 0;
-  virtual std::size_t ghosts_end() const = 0;
+  /// The part read back holds s[0, owned) of its own and ghosts up to
+  /// `ghosts_end`; refused (r.fail) when the saved ghosts sit elsewhere.
+  virtual void load(const ArchiveReader& r, const std::string& prefix, std::size_t owned, std::size_t ghosts_end) = 0;
+};
+
+/// The exchange of a subdomain that lives on one process: it owns every
+/// particle, builds no ghosts, and every collective is a no-op. Its periodic
+/// images are nearest images (pair_box), and the subdomain wraps positions
+/// and keeps the contact histories in place itself (migrate is not called).
+class OneProcessExchange final : public RankExchange {
+ public:
+  bool over_ranks() const override { return false; }
+  PeriodicBox pair_box(const PeriodicBox& box) const override { return box; }
+  void any(bool*, std::size_t) override {}
+  double max(double x) override { return x; }
+  std::size_t migrate(ParticleStore& s, std::size_t owned, const std::vector<std::uint64_t>&,
+                      const std::vector<PairHistories*>&) override {
+    s.truncate(owned);
+    return s.size();
+  }
+  void build_ghosts(ParticleStore&, std::size_t, double) override {}
+  void update_ghosts(ParticleStore&) override {}
+  void reverse(ParticleStore&) override {}
+  void reverse_counts(ParticleStore&) override {}
+  int rank() const override { return 0; }
+  int size() const override { return 1; }
+  void save(ArchiveWriter&, const std::string&) const override {}
+  void load(const ArchiveReader&, const std::string&, std::size_t, std::size_t) override {}
 };
 
 }  // namespace domel::platform

@@ -126,9 +126,9 @@ void Subdomain::wall_load(std::size_t wall, double f[3]) const {
 void Subdomain::set_rank_exchange(std::unique_ptr<RankExchange> ranks) {
   synchronize();
   ranks_ = std::move(ranks);
-  owned_ = store_.size();
-  ghosts_end_ = owned_;
-  nlist_.set_periodic(ranks_ ? PeriodicBox{} : box_);  // distributed: images are ghosts, separations plain
+  ghosts_ = 0;
+  ghosts_end_ = store_.size();
+  nlist_.set_periodic(ranks_->pair_box(box_));
 }
 
 void Subdomain::reset_forces() {
@@ -171,15 +171,15 @@ ParticleStore& Subdomain::store() {
 
 ParticleStore& Subdomain::particles_to_edit() {
   ParticleStore& s = store();
-  if (ranks_) {
-    s.truncate(owned_);  // the layout changes: the next step rebuilds the lists (on every rank)
+  if (ghosts_ != 0) {  // only a rank holds ghosts
+    s.truncate(owned());  // the layout changes: the next step rebuilds the lists (on every rank)
+    ghosts_ = 0;
     edited_ = true;
   }
   return s;
 }
 
 void Subdomain::collect_contact_counts() {
-  if (!ranks_) return;
   store();  // counts on owned and ghosts
   if (contacts_collected_) return;
   ranks_->reverse_counts(store_);
@@ -200,7 +200,7 @@ void Subdomain::setup() {
   } catch (const PluginError& e) {
     rethrow_with_context(e, "the initial force evaluation");
   }
-  if (ranks_) ranks_->reverse(store_);
+  ranks_->reverse(store_);
   const std::size_t n = owned();
   // Coinciding particles (two lines of a state file with one position)
   // have no contact normal: their forces are NaN, and the first step would
@@ -228,26 +228,28 @@ void Subdomain::setup() {
 
 
 void Subdomain::exchange() {
-  if (ranks_) {
-    // drop the ghosts, share space out by cost, move particles with the
-    // histories of the pairs they lead and of their wall contacts (their new
-    // rank computes those contacts)
-    const uint32_t stride = pipeline_->history_stride();
-    std::vector<PairHistories> h(1 + wall_lists_.size());
-    h[0] = nlist_.live_histories();
-    for (std::size_t w = 0; w < wall_lists_.size(); ++w) h[1 + w] = wall_lists_[w].live_histories(stride);
-    std::vector<PairHistories*> sets;
-    for (auto& set : h) sets.push_back(&set);
-    owned_ = ranks_->migrate(store_, owned_, rank_costs(), sets);
-    nlist_.adopt_histories(std::move(h[0]));
-    for (std::size_t w = 0; w < wall_lists_.size(); ++w)
-      if (wall_lists_[w].built) wall_lists_[w].adopt_histories(std::move(h[1 + w]));
-    ghosts_end_ = owned_;
+  // One process moves no particle to another: periodic boundaries are its
+  // whole migration (particles that left through a periodic face re-enter
+  // at the other), and the lists keep their histories in place
+  if (!ranks_->over_ranks()) {
+    if (box_.any()) box_.wrap(store_);
     return;
   }
-  // Periodic boundaries: the migration of one process, particles that left
-  // through a periodic face re-enter at the other
-  if (box_.any()) box_.wrap(store_);
+  // Over ranks: drop the ghosts, share space out by cost, move particles
+  // with the histories of the pairs they lead and of their wall contacts
+  // (their new rank computes those contacts)
+  const uint32_t stride = pipeline_->history_stride();
+  std::vector<PairHistories> h(1 + wall_lists_.size());
+  h[0] = nlist_.live_histories();
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w) h[1 + w] = wall_lists_[w].live_histories(stride);
+  std::vector<PairHistories*> sets;
+  for (auto& set : h) sets.push_back(&set);
+  ranks_->migrate(store_, owned(), rank_costs(), sets);
+  nlist_.adopt_histories(std::move(h[0]));
+  for (std::size_t w = 0; w < wall_lists_.size(); ++w)
+    if (wall_lists_[w].built) wall_lists_[w].adopt_histories(std::move(h[1 + w]));
+  ghosts_ = 0;
+  ghosts_end_ = store_.size();
 }
 
 void Subdomain::rebuild_lists() {
@@ -265,14 +267,10 @@ void Subdomain::rebuild_lists() {
     reordered_size_ = store_.size();
   }
   ++builds_since_reorder_;
-  if (ranks_) {
-    // the ghosts: every particle that can meet an owned one before the next
-    // build (cut-off: the largest diameter on any rank + the skin)
-    double rmax = 0.0;
-    for (std::size_t k = 0; k < owned_; ++k) rmax = std::max(rmax, store_.radius[k]);
-    ranks_->build_ghosts(store_, owned_, 2.0 * ranks_->max(rmax) + skin_);
-    ghosts_end_ = store_.size();
-  }
+  const std::size_t own = owned();
+  ranks_->build_ghosts(store_, own, skin_);  // every particle that can meet an owned one before the next build
+  ghosts_ = store_.size() - own;
+  ghosts_end_ = store_.size();
   nlist_.build(store_, pool_.get(), owned());
   far_active_ = false;
   for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
@@ -390,7 +388,9 @@ void Subdomain::synchronize() {
 }
 
 void Subdomain::step_deferred() {
-  if (hooks_.empty() && !ranks_) step_fused();
+  // the fused step owns every particle of the store; a rank completes its
+  // step in phase order, the exchanges between them
+  if (hooks_.empty() && !ranks_->over_ranks()) step_fused();
   else step_in_order();
 }
 
@@ -400,13 +400,11 @@ bool Subdomain::rebuild_due(bool stale) {
     beyond_skin = beyond_skin || c.beyond_skin != 0.0;
     beyond_near = beyond_near || c.beyond_near != 0.0;
   }
-  if (ranks_) {
-    // the same decision on every rank: a ghost moves as far as its owner
-    bool flags[2] = {stale || beyond_skin, beyond_near};
-    ranks_->any(flags, 2);
-    beyond_skin = flags[0];
-    beyond_near = flags[1];
-  }
+  // the same decision on every rank: a ghost moves as far as its owner
+  bool flags[2] = {stale || beyond_skin, beyond_near};
+  ranks_->any(flags, 2);
+  beyond_skin = flags[0];
+  beyond_near = flags[1];
   if (stale || walls_force_rebuild_ || beyond_skin) {
     walls_force_rebuild_ = false;
     return true;
@@ -480,11 +478,8 @@ void Subdomain::run_hooks(Phase phase) {
 
 void Subdomain::step_in_order() {
   synchronize();  // a step left pending before the first hook was added
-  if (ranks_ && edited_) {
-    owned_ = ghosts_end_ = store_.size();  // all owned here until the exchange moves them
-    edited_ = false;
-  }
-  if (ranks_ && store_.size() != ghosts_end_)
+  edited_ = false;  // the dropped ghosts: the lists are stale, this step rebuilds them
+  if (ghosts_ != 0 && store_.size() != ghosts_end_)
     throw RuntimeError("subdomain '" + name_ + "': particles were added or removed between steps of a distributed "
                        "run other than through particles_to_edit()");
   const double dt = dt_, half = 0.5 * dt_;
@@ -504,7 +499,7 @@ void Subdomain::step_in_order() {
     run_hooks(Phase::exchange);
     rebuild_lists();
     run_hooks(Phase::neighbor);
-  } else if (ranks_) {
+  } else {
     ranks_->update_ghosts(store_);  // ghost_update (a rebuild made fresh ghosts)
   }
   run_hooks(Phase::ghost_update);
@@ -518,7 +513,7 @@ void Subdomain::step_in_order() {
     rethrow_with_context(e, "the contact forces");
   }
   run_hooks(Phase::contact_force);
-  if (ranks_) ranks_->reverse(store_);
+  ranks_->reverse(store_);
   run_hooks(Phase::reverse_exchange);
   run_hooks(Phase::post_force);
   // final_integrate

@@ -90,7 +90,7 @@ class Subdomain {
   /// Periodic boundaries (core/neighbor_list.hpp); call before setup().
   void set_periodic(const PeriodicBox& box) {
     box_ = box;
-    if (!ranks_) nlist_.set_periodic(box);
+    nlist_.set_periodic(ranks_->pair_box(box));
   }
   const PeriodicBox& periodic() const { return box_; }
   /// Spread this subdomain over several ranks (rank_exchange.hpp): call
@@ -98,9 +98,9 @@ class Subdomain {
   /// particles and no ghosts. Pairs through periodic faces are then pairs
   /// with ghost images, and each step completes in phase order.
   void set_rank_exchange(std::unique_ptr<RankExchange> ranks);
-  bool distributed() const { return ranks_ != nullptr; }
+  bool distributed() const { return ranks_->over_ranks(); }
   /// The particles this rank owns: store()[0, owned()); the rest are ghosts.
-  std::size_t owned() const { return ranks_ && !edited_ ? owned_ : store_.size(); }
+  std::size_t owned() const { return store_.size() - ghosts_; }
   /// The store to add particles to or remove them from between steps (a
   /// pour, a deletion region, an inflow): store(), without the ghosts when
   /// distributed (what is added or removed is this rank's own; the next step
@@ -116,7 +116,7 @@ class Subdomain {
   /// an inflow's, a checkpoint's shared out anew): always on one process;
   /// spread over ranks, the rank starts_on_rank() names.
   bool keeps(std::uint64_t id) const {
-    return !elsewhere_ && (!ranks_ || starts_on_rank(id, ranks_->rank(), ranks_->size()));
+    return !elsewhere_ && starts_on_rank(id, ranks_->rank(), ranks_->size());
   }
   /// Re-order the store by spatial cells every `builds` neighbour-list
   /// builds (and after 10 % growth) when it holds 5000+ particles; 0: never.
@@ -329,11 +329,11 @@ class Subdomain {
   bool far_active_ = true;  ///< the far tier of the pair list is screened (see NeighborList::near_size)
   std::unique_ptr<ThreadPool> pool_;
   PeriodicBox box_;                     ///< set_periodic()
-  std::unique_ptr<RankExchange> ranks_;  ///< null: all particles on this process
-  std::size_t owned_ = 0;                ///< distributed: the owned particles, ghosts after them
-  std::size_t ghosts_end_ = 0;           ///< distributed: the store's size after the ghosts were built
-  bool edited_ = false;                  ///< distributed: particles_to_edit() dropped the ghosts
-  bool elsewhere_ = false;               ///< set_elsewhere()
+  std::unique_ptr<RankExchange> ranks_ = std::make_unique<OneProcessExchange>();  ///< set_rank_exchange()
+  std::size_t ghosts_ = 0;      ///< the ghosts at the end of the store (only a rank holds any)
+  std::size_t ghosts_end_ = 0;  ///< the store's size after the ghosts were built
+  bool edited_ = false;         ///< particles_to_edit() dropped ghosts that the lists name
+  bool elsewhere_ = false;      ///< set_elsewhere()
 };
 
 }  // namespace domel::platform

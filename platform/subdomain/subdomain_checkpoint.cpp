@@ -57,22 +57,21 @@ struct SubdomainSavedState {
 
 void Subdomain::save(ArchiveWriter& w, const std::string& p) {
   store();  // finishes the last step and counts the contacts
-  if (ranks_ && edited_)
+  if (edited_)
     throw RuntimeError("subdomain '" + name_ + "': a checkpoint between an edit of the particles and the next step "
                        "(the ghosts are dropped, the lists name them) cannot be written");
   SubdomainSavedState st{time_, dt_, coarse_grain_, skin_, last_max_overlap_ratio_, wall_time_, forces_time_,
                 steps_, last_contacts_, last_wall_contacts_, builds_since_reorder_, reordered_size_,
                 far_active_, walls_force_rebuild_};
-  if (ranks_) {
-    // this rank's part: its own particles, then its ghosts, and who holds which ghosts
-    st.ranked = true;
-    st.rank = static_cast<std::uint64_t>(ranks_->rank());
-    st.ranks = static_cast<std::uint64_t>(ranks_->size());
-    st.owned = owned_;
-    st.ghosts_end = ghosts_end_;
-    st.edited = edited_;
-    ranks_->save(w, p + "exchange/");
-  }
+  // over ranks, this rank's part: its own particles, then its ghosts, and
+  // who holds which ghosts (the fields are written for a part of a rank)
+  st.ranked = ranks_->over_ranks();
+  st.rank = static_cast<std::uint64_t>(ranks_->rank());
+  st.ranks = static_cast<std::uint64_t>(ranks_->size());
+  st.owned = owned();
+  st.ghosts_end = store_.size();
+  st.edited = edited_;
+  ranks_->save(w, p + "exchange/");
   st.walls = wall_lists_.size();
   for (const auto& ts : scratch_) st.thread_pair_contacts.push_back(ts.pair_contacts);
   save_fields(w, p + "state/", [&](CheckpointFields& f) { st.fields(f); });
@@ -85,23 +84,19 @@ void Subdomain::save(ArchiveWriter& w, const std::string& p) {
 bool Subdomain::restore(const ArchiveReader& r, const std::string& p) {
   SubdomainSavedState st;
   const std::size_t own = load_state(r, p, &st);
-  if (st.ranked != (ranks_ != nullptr))
-    r.fail(p + "state/ranked", ranks_ ? "holds a subdomain of one process; this run is spread over ranks"
-                                      : "holds a subdomain spread over ranks; this run is one process");
-  if (ranks_) {
-    if (st.rank != static_cast<std::uint64_t>(ranks_->rank()) || st.ranks != static_cast<std::uint64_t>(ranks_->size()))
-      r.fail(p + "state/rank", "is rank " + std::to_string(st.rank) + " of " + std::to_string(st.ranks) +
-                                   ", not rank " + std::to_string(ranks_->rank()) + " of " +
-                                   std::to_string(ranks_->size()));
-    owned_ = own;
-    ghosts_end_ = st.ghosts_end;
-    edited_ = st.edited;
-    if (owned_ > ghosts_end_ || ghosts_end_ != store_.size())
-      r.fail(p + "state/ghosts_end", "does not count the part's own particles and ghosts");
-    ranks_->load(r, p + "exchange/");
-    if (ranks_->ghosts_begin() != owned_ || ranks_->ghosts_end() != ghosts_end_)
-      r.fail(p + "exchange/ghosts/first", "does not place the ghosts after the rank's own particles");
-  }
+  if (st.ranked != ranks_->over_ranks())
+    r.fail(p + "state/ranked", st.ranked ? "holds a subdomain spread over ranks; this run is one process"
+                                         : "holds a subdomain of one process; this run is spread over ranks");
+  if (st.rank != static_cast<std::uint64_t>(ranks_->rank()) || st.ranks != static_cast<std::uint64_t>(ranks_->size()))
+    r.fail(p + "state/rank", "is rank " + std::to_string(st.rank) + " of " + std::to_string(st.ranks) +
+                                 ", not rank " + std::to_string(ranks_->rank()) + " of " +
+                                 std::to_string(ranks_->size()));
+  if (own > st.ghosts_end || st.ghosts_end != store_.size())
+    r.fail(p + "state/ghosts_end", "does not count the part's own particles and ghosts");
+  ghosts_ = store_.size() - own;
+  ghosts_end_ = store_.size();
+  edited_ = st.edited;
+  ranks_->load(r, p + "exchange/", own, ghosts_end_);
   if (st.thread_pair_contacts.size() != scratch_.size()) return false;  // the split is rebuilt at the next evaluation
   partition_.load(r, p + "split/");
   for (std::size_t t = 0; t < scratch_.size(); ++t) scratch_[t].pair_contacts = st.thread_pair_contacts[t];
@@ -145,11 +140,9 @@ void Subdomain::restore_shared_out(const std::vector<std::pair<const ArchiveRead
   nlist_.adopt_histories(std::move(h[0]));
   for (std::size_t w = 0; w < wall_lists_.size(); ++w)
     if (wall_lists_[w].built) wall_lists_[w].adopt_histories(std::move(h[1 + w]));
-  if (ranks_) {
-    owned_ = store_.size();
-    ghosts_end_ = owned_;
-    edited_ = false;
-  }
+  ghosts_ = 0;
+  ghosts_end_ = store_.size();
+  edited_ = false;
   exchange();
   rebuild_lists();
   // the statistics of the last evaluation, as this rank's lists hold them
@@ -176,10 +169,10 @@ std::size_t Subdomain::load_state(const ArchiveReader& r, const std::string& p, 
     r.fail(p + "state/coarse_grain", "was written with coarse_grain " + std::to_string(st.coarse_grain) +
                                          "; subdomain '" + name_ + "' now has " + std::to_string(coarse_grain_));
   if (st.skin != skin_) r.fail(p + "state/skin", "was written with another neighbour-list skin");
-  std::size_t own = st.ranked ? static_cast<std::size_t>(st.owned) : SIZE_MAX;
   nlist_.configure(skin_, pipeline_->history_stride());
   store_.load(r, p + "particles/");
-  if (own == SIZE_MAX) own = store_.size();
+  if (!st.ranked) st.owned = st.ghosts_end = store_.size();  // a part of one process: all its own, no ghosts
+  const auto own = static_cast<std::size_t>(st.owned);
   if (own > store_.size()) r.fail(p + "state/owned", "counts more particles than the part holds");
   nlist_.load(r, p + "pairs/");
   const std::size_t n = store_.size();

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <random>
 #include <unordered_map>
 
@@ -354,4 +355,47 @@ TEST(MpiSubdomain, AFieldAddedInOnePlaceMigratesReachesTheGhostsAndSurvivesARest
   for (std::size_t k = 0; k < sd.owned(); ++k)
     differ += a.id[k] != b.id[k] || a.x[k] != b.x[k] || a.vx[k] != b.vx[k] || a.aux[tag][k] != b.aux[tag2][k];
   EXPECT_EQ(differ, 0u) << "rank " << comm.rank() << ": the restarted run differs from the uninterrupted one";
+}
+
+// Issue 40: particles_to_edit() drops the ghosts once; a second edit in the
+// same macro step (a coupling's inflow, then a deletion region) keeps what
+// the first one added. The gas after one step (ghosts on every rank, the
+// periodic images on one rank too): a particle added on rank 0 survives two
+// further edits, and after its removal the run steps on with every other
+// particle. Well under a second on 1-4 ranks.
+TEST(MpiSubdomain, ASecondEditBetweenStepsKeepsWhatTheFirstAdded) {
+  const dp::Communicator comm = dp::Communicator::world();
+  auto run = prepared(gas(), true, &comm);
+  dp::Subdomain& sd = run.sd();
+  sd.step();
+  ASSERT_GT(sd.size(), sd.owned()) << "rank " << comm.rank() << ": the check needs ghosts";
+  std::vector<std::uint64_t> before{sd.owned()};
+  comm.sum(before);
+  constexpr std::uint64_t kNewId = 1u << 30;
+  {
+    dp::ParticleStore& s = sd.particles_to_edit();
+    if (comm.rank() == 0) {
+      dp::ParticleStore one = s.empty_like();
+      one.append(s, std::vector<std::uint32_t>{0});
+      one.id[0] = kNewId;
+      s.append(one);
+    }
+  }
+  auto holds_new = [&] {
+    const dp::ParticleStore& s = sd.particles_to_edit();
+    return std::count(s.id.begin(), s.id.end(), kNewId);
+  };
+  EXPECT_EQ(holds_new(), comm.rank() == 0 ? 1 : 0) << "rank " << comm.rank() << ": the second edit lost the particle";
+  EXPECT_EQ(holds_new(), comm.rank() == 0 ? 1 : 0) << "rank " << comm.rank() << ": the third edit lost the particle";
+  {
+    dp::ParticleStore& s = sd.particles_to_edit();
+    std::vector<std::uint8_t> drop(s.size(), 0);
+    for (std::size_t k = 0; k < s.size(); ++k) drop[k] = s.id[k] == kNewId;
+    s.remove_marked(drop);
+  }
+  sd.step();
+  std::vector<std::uint64_t> after{sd.owned()};
+  comm.sum(after);
+  EXPECT_EQ(after[0], before[0]);
+  EXPECT_GT(sd.size(), sd.owned()) << "rank " << comm.rank() << ": the step rebuilt no ghosts";
 }
