@@ -4,8 +4,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace domel::platform {
+
+std::string schedule_refusal(double period, double tick, const std::string& what) {
+  if (!(period > 0) || !(tick > 0) || period >= tick * (1.0 - kTimeTolerance)) return {};
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "expected at least the macro step, %.6g s (the largest subdomain time step: %s are due at macro "
+                "steps, at most one per step), or 0 to switch them off; found %.6g s",
+                tick, what.c_str(), period);
+  return buf;
+}
 
 Cadence Cadence::in_time(double period, double first, double tick) {
   Cadence c;
@@ -60,14 +71,21 @@ void Cadence::advance(std::uint64_t tick) {
   }
   // every due time reached by tick's time t: jump close to t in one go (a
   // period far below the tick would otherwise loop many times), then settle
-  // on the first due time past t
+  // on the first due time past t, a few periods on at most. A period below
+  // what the times resolve (first + k x period no longer grows with k, or k
+  // beyond 2^64) leaves the next due time reached: due at every tick, as
+  // any period below the tick is, and never a loop without end.
   const double t = static_cast<double>(tick) * tick_;
   const double guess = std::floor((t + tolerance_ - first_) / period_);
-  if (guess > static_cast<double>(k_) + 1 && guess < 9e15) k_ = static_cast<std::uint64_t>(guess) - 1;
-  do {
+  constexpr double kIndexLimit = 1.8e19;  // below 2^64
+  if (guess > static_cast<double>(k_) + 1) k_ = guess < kIndexLimit ? static_cast<std::uint64_t>(guess) - 1 : k_;
+  for (int left = 64; left > 0; --left) {
+    const double before = next_;
+    if (k_ == std::numeric_limits<std::uint64_t>::max()) break;
     ++k_;
     next_ = first_ + static_cast<double>(k_) * period_;
-  } while (next_ <= t + tolerance_);
+    if (next_ > t + tolerance_ || !(next_ > before)) break;
+  }
   settle();
 }
 

@@ -23,12 +23,21 @@
 
 #include <cstdint>
 #include <limits>
+#include <string>
 
 namespace domel::platform {
 
 /// Fraction of the macro step by which a time may fall short of a due time
 /// and still count as having reached it.
 inline constexpr double kTimeTolerance = 1e-9;
+
+/// Why an interval of `period` seconds cannot be kept on a clock whose
+/// ticks are `tick` seconds apart (the macro step): below one tick, where
+/// at most one action per tick is due; empty when it can (0, off, can).
+/// `what` names the actions ("particle files"). The scenario's schedules
+/// are checked with it at validate (scenario/build_schedules.cpp); an output
+/// kind with an interval of its own checks it the same way.
+std::string schedule_refusal(double period, double tick, const std::string& what);
 
 class Cadence {
  public:

@@ -8,7 +8,8 @@
 // regions, mass-flow planes, region masses, wall loads and contacts),
 // build_couplings.cpp (couplings between levels, the scene's bounds),
 // build_fluid.cpp (the fluid block), build_outputs.cpp (grids, the repose
-// probe, the output settings, the run's components).
+// probe, the output settings, the run's components), build_schedules.cpp
+// (every interval in seconds against the macro step).
 #pragma once
 
 #include "outputs/grid_files.hpp"
@@ -78,6 +79,12 @@ bool domain_bounds(Build& b, double lo[3], double hi[3]);
 std::optional<FluidSpec> build_fluid(Build& b);
 // build_outputs.cpp
 void build_grids(Build& b);
+/// The run's duration: run.duration, or run.steps macro steps (after the subdomains).
+void build_duration(Build& b);
+// build_schedules.cpp
+/// Every interval given in seconds at least one macro step (refused at its
+/// pointer otherwise); more than 1e5 actions in a run warned about.
+void check_schedules(Build& b);
 void build_repose_probe(Build& b);
 void build_outputs(Build& b);
 void register_components(Build& b);

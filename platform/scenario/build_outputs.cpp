@@ -107,14 +107,17 @@ void build_repose_probe(Build& b) {
   b.sim.repose_probe = rp;
 }
 
-void build_outputs(Build& b) {
-  Simulation& sim = b.sim;
+void build_duration(Build& b) {
   const json& run = b.doc["run"];
   if (run.contains("duration")) {
-    sim.duration = run["duration"].get<double>();
+    b.sim.duration = run["duration"].get<double>();
   } else {
-    sim.duration = static_cast<double>(run["steps"].get<std::uint64_t>()) * sim.macro_step();
+    b.sim.duration = static_cast<double>(run["steps"].get<std::uint64_t>()) * b.sim.macro_step();
   }
+}
+
+void build_outputs(Build& b) {
+  Simulation& sim = b.sim;
   const json& out = b.doc["output"];
   sim.output_directory = out.contains("directory") ? out["directory"].get<std::string>() : sim.name + "_out";
   b.out.vtk_interval = out.contains("vtk_interval") ? out["vtk_interval"].get<double>() : sim.duration / 50.0;

@@ -42,6 +42,8 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_repose_probe(b);
   build_contact_outputs(b);
   std::optional<FluidSpec> fluid = build_fluid(b);
+  build_duration(b);
+  check_schedules(b);
   if (!b.ck.diags.empty()) throw ConfigError(b.ck.diags);
   build_outputs(b);
   if (fluid) {

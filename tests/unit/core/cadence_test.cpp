@@ -5,10 +5,14 @@
 // run, several due times within one tick firing once; in ticks, due every n
 // ticks exactly; never due when disabled; and a restart going on from the
 // index it was checkpointed at, or past the checkpoint's tick when the
-// period changed.
+// period changed; a period below what the times resolve firing every tick
+// without looping, and the refusal of an interval below the tick.
 #include <gtest/gtest.h>
 
 #include "core/cadence.hpp"
+
+#include <cstdint>
+#include <string>
 
 namespace {
 
@@ -48,6 +52,35 @@ TEST(Cadence, APeriodBelowTheTickFiresEveryTick) {
   for (std::uint64_t m = 0; m < 10; ++m) fired += c.take(m) ? 1 : 0;
   EXPECT_EQ(fired, 10);
   EXPECT_GT(c.next_time(), 9e-3);
+}
+
+// Issue 41: a period far below what the times resolve (1e-22 s on a clock of
+// 1e-5 s; 1e-300 s after a first time of 0.5 s, where first + k period no
+// longer grows with k) used to loop for ever in advance(). Each take() now
+// ends after a few periods, and the cadence fires at every tick from the
+// first one that reaches its first time, as any period below the tick does.
+// 100 000 ticks, a few milliseconds.
+TEST(Cadence, APeriodBelowWhatTheTimesResolveFiresEveryTickAndNeverLoops) {
+  const double tick = 1e-5;
+  Cadence tiny = Cadence::in_time(1e-22, 0.0, tick);
+  Cadence lost = Cadence::in_time(1e-300, 0.5, tick);
+  std::uint64_t fired_tiny = 0, fired_lost = 0;
+  for (std::uint64_t m = 0; m < 100000; ++m) {
+    fired_tiny += tiny.take(m) ? 1 : 0;
+    fired_lost += lost.take(m) ? 1 : 0;
+  }
+  EXPECT_EQ(fired_tiny, 100000u);
+  EXPECT_EQ(fired_lost, 100000u - 50000u);  // ticks 50000 .. 99999 reach 0.5 s
+}
+
+TEST(Cadence, AnIntervalBelowTheTickIsRefusedWithTheStepAndTheValue) {
+  EXPECT_EQ(domel::platform::schedule_refusal(1e-5, 1e-5, "frames"), "");
+  EXPECT_EQ(domel::platform::schedule_refusal(0.0, 1e-5, "frames"), "");  // off
+  EXPECT_EQ(domel::platform::schedule_refusal(1e-5 * (1 - 0.5 * kTimeTolerance), 1e-5, "frames"), "");
+  const std::string why = domel::platform::schedule_refusal(1e-22, 1e-5, "frames");
+  EXPECT_NE(why.find("expected at least the macro step, 1e-05 s"), std::string::npos) << why;
+  EXPECT_NE(why.find("frames"), std::string::npos) << why;
+  EXPECT_NE(why.find("found 1e-22 s"), std::string::npos) << why;
 }
 
 TEST(Cadence, InTicksIsDueEveryNTicksFromTheFirst) {
