@@ -5,7 +5,6 @@
 #include "core/archive.hpp"
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <type_traits>

@@ -205,7 +205,7 @@ ExchangeCounts GhostExchange::build(ParticleStore& s, std::size_t owned, const D
   std::vector<std::vector<char>> send(nr);
   for (std::size_t r = 0; r < nr; ++r) send[r] = pack_particles(s, sent_[r], &shift_[r], ParticleStore::kGhostBuild);
   const auto recv = comm.all_to_all(send);
-  const std::size_t per = particle_bytes(s);
+  const std::size_t per = particle_bytes(s, ParticleStore::kGhostBuild);  // what a ghost carries
   first_.assign(nr + 1, 0);
   for (std::size_t r = 0; r < nr; ++r) {
     first_[r] = s.size();
