@@ -5,6 +5,7 @@ that collect failures, and a run with a time limit (a hang fails, it does
 not block)."""
 import os
 import subprocess
+import time
 
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl="self,vader")
 failures = []
@@ -41,3 +42,15 @@ def run(cmd, timeout=240):
     except subprocess.TimeoutExpired:
         check(False, "timed out (a hang): " + " ".join(cmd))
         return None
+
+
+_part = {"name": None, "start": 0.0}
+
+
+def part(name):
+    """Start the script's part `name` (None: the end), printing how long the
+    previous part took: what each part costs shows in the test's log."""
+    now = time.monotonic()
+    if _part["name"] is not None:
+        print(f"[{_part['name']}: {now - _part['start']:.1f} s]", flush=True)
+    _part["name"], _part["start"] = name, now
