@@ -12,6 +12,7 @@
 
 #include "core/archive.hpp"
 #include "core/error.hpp"
+#include "geometry/wall_clearance.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
 #include "loop/ranks.hpp"
@@ -375,8 +376,11 @@ std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const st
   };
   for (std::size_t k = 0; k < s.size(); ++k) add_to_bins(k);
   std::vector<const WallPrimitive*> active;
+  std::vector<WallPrimitive> meshes;  // their closest triangles: WallClearance
   for (const auto& w : walls)
-    if (w.active(t)) active.push_back(&w);
+    if (w.active(t) && w.shape == WallPrimitive::Shape::mesh) meshes.push_back(w);
+    else if (w.active(t)) active.push_back(&w);
+  const WallClearance mesh_clearance(meshes, t, rmax);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   std::size_t placed = 0;
   while (!fb.queue.empty()) {
@@ -393,10 +397,11 @@ std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const st
       if (!room) break;
       ok = true;
       for (const WallPrimitive* w : active)
-        if (w->shape != WallPrimitive::Shape::mesh && w->near(p[0], p[1], p[2], r)) {
+        if (w->near(p[0], p[1], p[2], r)) {
           ok = false;
           break;
         }
+      ok = ok && (mesh_clearance.empty() || mesh_clearance.clear(p, r));
       if (!ok) continue;
       int c[3];
       bin_of(p[0], p[1], p[2], c);

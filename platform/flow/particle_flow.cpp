@@ -6,6 +6,7 @@
 #include "core/archive.hpp"
 #include "core/error.hpp"
 #include "geometry/region.hpp"
+#include "geometry/wall_clearance.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -159,6 +160,25 @@ void ParticleFlow::setup(RunContext& ctx) {
   if (!ctx.restart) start(ctx.subdomains);  // a restart's restore() started it
 }
 
+std::size_t drop_wall_overlaps(InsertionCandidates& c, const std::vector<WallPrimitive>& walls, double t) {
+  if (walls.empty() || c.size() == 0) return 0;
+  double r_max = 0;
+  for (double r : c.r) r_max = std::max(r_max, r);
+  const WallClearance clearance(walls, t, r_max);
+  std::size_t kept = 0;
+  for (std::size_t q = 0; q < c.size(); ++q) {
+    const double p[3] = {c.x[q], c.y[q], c.z[q]};
+    if (clearance.overlap(p, c.r[q]) > 1e-9 * c.r[q]) continue;  // more than round-off (a lattice touching a wall)
+    c.x[kept] = c.x[q]; c.y[kept] = c.y[q]; c.z[kept] = c.z[q]; c.r[kept] = c.r[q];
+    if (!c.component.empty()) c.component[kept] = c.component[q];
+    ++kept;
+  }
+  const std::size_t dropped = c.size() - kept;
+  c.x.resize(kept); c.y.resize(kept); c.z.resize(kept); c.r.resize(kept);
+  if (!c.component.empty()) c.component.resize(kept);
+  return dropped;
+}
+
 void ParticleFlow::finish(RunContext& ctx, nlohmann::json& out) {
   if (empty()) return;
   check_planes(ctx.subdomains);
@@ -195,6 +215,8 @@ void ParticleFlow::pour(Pour& p, double t, Subdomain& sd) {
   } catch (const PluginError& e) {
     throw RuntimeError(p.where + ": the pour's insertion failed at t = " + std::to_string(t) + " s: " + e.what());
   }
+  // no particle placed in a wall: a shortfall this leaves is made up later, as a full region's
+  if (!p.fixed) drop_wall_overlaps(c, sd.reference_walls(), t);
   // The candidates are independent random draws in random order, so taking
   // them in order until the mass target is met keeps the size distribution.
   // Spread over ranks, every rank takes the same ones and keeps each new

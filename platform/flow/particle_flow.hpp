@@ -73,6 +73,12 @@ InsertionCandidates request_insertion(const ModelInstance& model, const domel_re
                                       double alpha, const ParticleStore* present, std::size_t max_count,
                                       const PeriodicBox& box = {}, bool components = false);
 
+/// Drop the candidates that would overlap a wall of `walls` (the reference
+/// state of the scenario's walls) as they stand at time t: no particle is
+/// placed in contact with a wall, whatever its kind (issue 41). Keeps the
+/// order of the rest; returns how many it dropped.
+std::size_t drop_wall_overlaps(InsertionCandidates& c, const std::vector<WallPrimitive>& walls, double t);
+
 /// Exact mass in units of 1e-18 kg (sums in 128 bits).
 using MassUnits = __int128;
 MassUnits mass_units(double kg);

@@ -59,6 +59,29 @@ bool domain_bounds(Build& b, double lo[3], double hi[3]) {
   return walls_and_regions_bounds(b, lo, hi, false);
 }
 
+/// Where a top-level level's particle centres can be: the box of
+/// domain_bounds() when cylinders, cones or meshes enclose the scene (else
+/// all space), cut down by every axis-aligned plane that stands from the
+/// start to the end of the run (a box's faces, a floor): nothing stays
+/// behind a plane. Unbounded sides are infinite. False when nothing bounds
+/// it at all.
+bool reachable_box(Build& b, double lo[3], double hi[3]) {
+  bool any = domain_bounds(b, lo, hi);
+  if (!any)
+    for (int a = 0; a < 3; ++a) lo[a] = -HUGE_VAL, hi[a] = HUGE_VAL;
+  for (const auto& w : b.sim.walls) {
+    if (w.shape != WallPrimitive::Shape::plane || w.moving || std::isfinite(w.remove_at) || w.active_from > 0)
+      continue;
+    for (int a = 0; a < 3; ++a) {
+      if (std::fabs(w.n[a]) < 1.0 - 1e-12) continue;
+      if (w.n[a] > 0) lo[a] = std::max(lo[a], w.p[a]);
+      else hi[a] = std::min(hi[a], w.p[a]);
+      any = true;
+    }
+  }
+  return any;
+}
+
 /// The box of the enclosing walls (mantles, meshes) and of every region
 /// (deletion, pour, insertion); with `all`, also of every other finite wall
 /// (disks, a box's faces, a container's bottom) and a plane's point.
@@ -305,15 +328,82 @@ void build_couplings(Build& b) {
         }
     } else {
       double lo[3], hi[3];
-      if (domain_bounds(b, lo, hi))
+      auto bound = [](double v) { return std::isfinite(v) ? fmt_num(v) : std::string(v < 0 ? "-inf" : "inf"); };
+      if (reachable_box(b, lo, hi))
         for (int a = 0; a < 3; ++a)
           if (s.grid.lo[a] < lo[a] - 1e-12 || s.grid.hi[a] > hi[a] + 1e-12) {
             b.ck.add(base + "/region", "the fine region lies outside the coarse level's domain along " +
                                            std::string(1, "xyz"[a]) + ": [" + fmt_num(s.grid.lo[a]) + ", " +
-                                           fmt_num(s.grid.hi[a]) + "] m against [" + fmt_num(lo[a]) + ", " +
-                                           fmt_num(hi[a]) + "] m (the walls, pour, insertion and deletion regions)");
+                                           fmt_num(s.grid.hi[a]) + "] m against [" + bound(lo[a]) + ", " +
+                                           bound(hi[a]) + "] m (the walls, pour, insertion and deletion regions)");
             break;
           }
+    }
+    // behind a plane wall at a slant: every corner on the wall's far side
+    for (const auto& w : sim.walls) {
+      if (b.ck.diags.size() > before) break;  // outside the box already (an axis-aligned plane's far side)
+      if (w.shape != WallPrimitive::Shape::plane || w.moving || std::isfinite(w.remove_at) || w.active_from > 0)
+        continue;
+      bool behind = true;
+      for (int corner = 0; corner < 8 && behind; ++corner) {
+        double d = 0;
+        for (int a = 0; a < 3; ++a) d += ((corner >> a & 1 ? s.grid.hi[a] : s.grid.lo[a]) - w.p[a]) * w.n[a];
+        behind = d < 0;
+      }
+      if (behind) {
+        b.ck.add(base + "/region", "the fine region [" + fmt_num(s.grid.lo[0]) + ", " + fmt_num(s.grid.hi[0]) +
+                                       "] x [" + fmt_num(s.grid.lo[1]) + ", " + fmt_num(s.grid.hi[1]) + "] x [" +
+                                       fmt_num(s.grid.lo[2]) + ", " + fmt_num(s.grid.hi[2]) +
+                                       "] m lies behind the plane '" + w.name + "' (" + idx("/walls", w.wall) +
+                                       "), where no particle can be");
+        break;
+      }
+    }
+    // Material inside the region at the start, or poured into it: the fine
+    // level receives what crosses its inflow faces, never what is already
+    // inside, so unless the fine level starts with particles of its own for
+    // it, that material would never reach the fine level.
+    auto inside = [&](double x, double y, double z) {
+      const double p[3] = {x, y, z};
+      for (int a = 0; a < 3; ++a)
+        if (!(p[a] > s.grid.lo[a] && p[a] < s.grid.hi[a])) return false;
+      return true;
+    };
+    if (fine.store().size() == 0 && b.ck.diags.size() == before) {  // one problem of the region at a time
+      const ParticleStore& cp = coarse.store();
+      std::size_t n = 0;
+      double kg = 0;
+      for (std::size_t q = 0; q < cp.size(); ++q)
+        if (inside(cp.x[q], cp.y[q], cp.z[q])) ++n, kg += cp.mass[q];
+      if (n > 0)
+        b.ck.add(base + "/region",
+                 std::to_string(n) + " parcel(s) of '" + names[s.coarse] + "' (" + fmt_num(kg) +
+                     " kg) lie inside the fine region at the start; the fine level '" + names[s.fine] +
+                     "' receives only what crosses its inflow faces, so their material would never reach it",
+                 "start the coarse level's particles outside the region, or give '" + names[s.fine] +
+                     "' particles of its own for that material (insert or initial_state)");
+    }
+    for (std::size_t q = 0; q < sim.flow.pours.size(); ++q) {
+      const Pour& p = sim.flow.pours[q];
+      if (p.subdomain != s.coarse) continue;
+      double lo[3], hi[3];
+      region_box(p.region, lo, hi);
+      bool reaches = false;
+      constexpr int kSamples = 9;
+      for (int i = 0; i < kSamples && !reaches; ++i)
+        for (int j = 0; j < kSamples && !reaches; ++j)
+          for (int k = 0; k < kSamples && !reaches; ++k) {
+            const double x = lo[0] + (hi[0] - lo[0]) * i / (kSamples - 1.0);
+            const double y = lo[1] + (hi[1] - lo[1]) * j / (kSamples - 1.0);
+            const double z = lo[2] + (hi[2] - lo[2]) * k / (kSamples - 1.0);
+            reaches = region_contains(p.region, x, y, z) && inside(x, y, z);
+          }
+      if (reaches)
+        b.ck.add(p.where + "/insert/region",
+                 "the pour of '" + names[s.coarse] + "' places parcels inside the fine region of " + base +
+                     "; they never cross its inflow faces, so their material would never reach the fine level '" +
+                     names[s.fine] + "'",
+                 "pour above or beside the fine region");
     }
     // two fine regions that overlap (a nested region lies inside its parent's, which is fine)
     for (std::size_t h = 0; h < specs.size(); ++h) {

@@ -5,6 +5,7 @@
 #include "scenario/build.hpp"
 
 #include "geometry/region.hpp"
+#include "geometry/wall_clearance.hpp"
 #include "io/particle_state.hpp"
 #include "subdomain/diagnostics.hpp"
 #include "scenario/scenario.hpp"
@@ -81,6 +82,58 @@ std::unique_ptr<ContactPipeline> build_contact_pipeline(Build& b, const json& sd
   return std::make_unique<ContactPipeline>(std::move(slots), std::move(pair_rolling));
 }
 
+/// The starting particles (but the fixed ones) against the walls at the start: overlaps
+/// delta / R above `limit` (run.max_initial_overlap) refused naming the
+/// particle and the wall, smaller ones reported (a settled state file rests
+/// on its walls).
+void check_initial_wall_overlaps(Build& b, const ParticleStore& s, const json& sd, const std::string& name,
+                                 const std::string& source, double limit) {
+  if (b.sim.walls.empty() || s.size() == 0) return;
+  double r_max = 0;
+  for (double r : s.radius) r_max = std::max(r_max, r);
+  const WallClearance clearance(b.sim.walls, 0.0, r_max);
+  struct Hit {
+    std::uint64_t id;
+    std::size_t wall;
+    double ratio;
+  };
+  std::vector<Hit> above;
+  std::size_t touching = 0;
+  Hit worst{0, 0, 0.0};
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (s.fixed(k)) continue;  // never moved, no wall force: a rough floor may stand in a wall
+    const double p[3] = {s.x[k], s.y[k], s.z[k]};
+    std::size_t w = 0;
+    const double delta = clearance.overlap(p, s.radius[k], &w);
+    if (delta <= 0) continue;
+    ++touching;
+    const Hit h{s.id[k], w, delta / s.radius[k]};
+    if (h.ratio > worst.ratio) worst = h;
+    if (h.ratio > limit) above.push_back(h);
+  }
+  auto wall_name = [&](std::size_t w) {
+    return "'" + b.sim.walls[w].name + "' (" + idx("/walls", b.sim.walls[w].wall) + ")";
+  };
+  if (touching > 0)
+    spdlog::info("subdomain '{}': {} particle(s) touch a wall at the start, the worst {:.3g} % of its radius (id {}, "
+                 "wall {})", name, touching, 100.0 * worst.ratio, worst.id, wall_name(worst.wall));
+  if (above.empty()) return;
+  std::sort(above.begin(), above.end(), [](const Hit& a, const Hit& c) { return a.ratio > c.ratio; });
+  std::string list;
+  for (std::size_t k = 0; k < above.size() && k < 5; ++k)
+    list += (k ? ", " : "") + std::string("id ") + std::to_string(above[k].id) + " into " + wall_name(above[k].wall) +
+            " by " + fmt_num(100.0 * above[k].ratio) + " % of its radius";
+  b.ck.add(source,
+           std::to_string(above.size()) + " particle(s) overlap a wall by more than run.max_initial_overlap (" +
+               fmt_num(100.0 * limit) + " % of the particle's radius) at the start: " + list +
+               (above.size() > 5 ? ", ..." : "") +
+               (sd.contains("initial_state") ? " in the state file '" + sd["initial_state"].get<std::string>() + "'"
+                                             : "") +
+               "; their first contact forces would blow them away",
+           "move or remove those particles (or the wall), or raise /run/max_initial_overlap if the overlaps are "
+           "intended");
+}
+
 /// What can be known about a subdomain's starting particles before a step:
 /// overlapping pairs (refused above run.max_initial_overlap, with the ids),
 /// an empty subdomain that nothing fills, and sizes that suggest a scenario
@@ -114,6 +167,7 @@ void check_initial_particles(Build& b, const Subdomain& sub, const json& sd, con
                  "; their first contact forces would blow them apart",
              "separate or remove those particles, or raise /run/max_initial_overlap if the overlaps are intended");
   }
+  check_initial_wall_overlaps(b, s, sd, name, source, limit);
   bool fed = sd.contains("pour") && !sd["pour"].empty();
   fed = fed || b.parent.count(name) != 0;  // the fine level of a coupling is filled by its parent
   if (s.size() == 0 && !fed)
@@ -253,6 +307,18 @@ std::uint64_t name_hash(const std::string& name) {
   return h;
 }
 
+/// True (and reported at `where`) when the region lies wholly inside the
+/// walls as they stand at the start: nothing can be placed in it.
+bool region_inside_walls(Build& b, const domel_region_v1& region, const std::string& where) {
+  const WallClearance clearance(b.sim.walls, 0.0, 0.0);
+  std::size_t w = 0;
+  if (!clearance.covers(region, &w)) return false;
+  b.ck.add(where, "the region lies wholly inside the wall '" + b.sim.walls[w].name + "' (" +
+                      idx("/walls", b.sim.walls[w].wall) + "): no particle can be placed in it",
+           "move the region to the particles' side of the wall");
+  return true;
+}
+
 /// The start-up insertions, in order, after the initial state (whose
 /// particles they avoid).
 void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::string& base) {
@@ -263,10 +329,14 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
     const std::string where = idx(base + "/insert", q);
     try {
       const Inserter ins = make_inserter(b, block, sub, b.sim.seed * 1000003ull + hash + q);
+      if (region_inside_walls(b, ins.region, where + "/region")) continue;
       ParticleStore& st = sub.store();
-      const InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
-                                                      b.sim.flow.max_particles, sub.periodic(),
-                                                      ins.materials.mixture());
+      InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
+                                                b.sim.flow.max_particles, sub.periodic(), ins.materials.mixture());
+      // fixed particles (a rough floor) feel no wall and may stand in one
+      if (const std::size_t dropped = ins.fixed ? 0 : drop_wall_overlaps(c, b.sim.walls, 0.0))
+        spdlog::info("subdomain '{}': {} of the places {} chose overlap a wall and are left empty", sub.name(),
+                     dropped, where);
       st.reserve(st.size() + c.size());
       for (std::size_t p = 0; p < c.size(); ++p) {
         st.add(b.next_id++, c.x[p], c.y[p], c.z[p], c.r[p], ins.materials.density_of(c, p), ins.fixed,
@@ -303,6 +373,7 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
     const std::string where = idx(base + "/pour", q);
     try {
       const Inserter ins = make_inserter(b, pb["insert"], sub, b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
+      if (region_inside_walls(b, ins.region, where + "/insert/region")) continue;
       Pour p;
       p.where = where;
       p.subdomain = b.sim.subdomains.size();
@@ -334,8 +405,9 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
           p.interval = 0.01;
         }
       }
-      const InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr,
-                                                      b.sim.flow.max_particles, {}, p.materials.mixture());
+      InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr,
+                                                b.sim.flow.max_particles, {}, p.materials.mixture());
+      if (!p.fixed) drop_wall_overlaps(c, b.sim.walls, p.start);
       if (c.size() == 0) {
         b.ck.add(where + "/insert", "the insertion model placed no particle in the pour region",
                  "enlarge the region or raise the model's volume_fraction / count");

@@ -4,6 +4,7 @@
 
 #include "scenario/scenario.hpp"
 
+#include <iomanip>
 #include <sstream>
 #include <vector>
 
@@ -67,6 +68,15 @@ std::string constraint_of(const json& s, const json& root) {
   if (r.contains("exclusiveMinimum")) add("> " + r["exclusiveMinimum"].dump());
   if (r.contains("maximum")) add("<= " + r["maximum"].dump());
   if (r.contains("exclusiveMaximum")) add("< " + r["exclusiveMaximum"].dump());
+  if (r.contains("x-plausible")) {  // refused outside unless run.allow_implausible
+    auto num = [](const json& v) {
+      std::ostringstream os;
+      os << std::setprecision(6) << v.get<double>();
+      return os.str();
+    };
+    add("plausible " + num(r["x-plausible"]["range"][0]) + " to " + num(r["x-plausible"]["range"][1]) + " (" +
+        r["x-plausible"]["why"].get<std::string>() + "; run.allow_implausible accepts more)");
+  }
   if (r.contains("enum")) {
     std::string e;
     for (const auto& v : r["enum"]) e += (e.empty() ? "" : ", ") + v.dump();

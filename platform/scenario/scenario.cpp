@@ -24,6 +24,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <set>
 #include <sstream>
@@ -680,6 +681,58 @@ void check_references(Checker& ck, const json& doc, const Filled& filled) {
 /// The passes, in order; fills the schema defaults into `doc` on the way
 /// (after the platform schema's check, so that the later passes and the
 /// builders read every defaulted value from the document).
+namespace {
+
+/// Material and interaction values against the ranges the schema gives them
+/// ("x-plausible": a range and where it comes from): outside, refused at
+/// their pointer with the range, unless /run/allow_implausible (then a
+/// warning each). A value the schema refused already is left to that.
+void check_plausible(Checker& ck, const json& doc) {
+  const json& defs = platform_scenario_schema()["$defs"];
+  const json* run = member(doc, "run");
+  const json* allow_j = run ? member(*run, "allow_implausible") : nullptr;
+  const bool allow = allow_j && allow_j->is_boolean() && allow_j->get<bool>();
+  auto refused_already = [&](const std::string& ptr) {
+    return std::any_of(ck.diags.begin(), ck.diags.end(), [&](const Diagnostic& d) { return d.pointer == ptr; });
+  };
+  auto check = [&](const json& object, const json& properties, const std::string& at) {
+    if (!object.is_object()) return;
+    for (const auto& [key, prop] : properties.items()) {
+      const json* plausible = member(prop, "x-plausible");
+      const json* v = member(object, key.c_str());
+      if (!plausible || !v || !v->is_number()) continue;
+      const std::string ptr = at + "/" + key;
+      const double x = v->get<double>();
+      const double lo = (*plausible)["range"][0].get<double>(), hi = (*plausible)["range"][1].get<double>();
+      if ((x >= lo && x <= hi) || refused_already(ptr)) continue;
+      const json* unit_j = member(prop, "x-unit");
+      const std::string unit = unit_j && unit_j->is_string() ? unit_j->get<std::string>() : "1";
+      auto num = [](double d) {
+        std::ostringstream os;
+        os << std::setprecision(6) << d;
+        return os.str();
+      };
+      const std::string msg = "expected a plausible value within [" + num(lo) + ", " + num(hi) + "]" +
+                              (unit == "1" ? "" : " " + unit) + " (" + (*plausible)["why"].get<std::string>() +
+                              "), found " + fmt_num(x);
+      if (allow)
+        spdlog::warn("{}: {}; accepted (/run/allow_implausible)", ptr, msg);
+      else
+        ck.add(ptr, msg,
+               "if it is meant (a scaled density, a deliberately extreme value), set /run/allow_implausible to "
+               "true; a scenario in other units needs converting to SI (m, kg, s)");
+    }
+  };
+  if (const json* mats = member(doc, "materials"); mats && mats->is_object())
+    for (const auto& [name, m] : mats->items())
+      check(m, defs["material"]["properties"], "/materials/" + escape_pointer_token(name));
+  if (const json* its = member(doc, "interactions"); its && its->is_array())
+    for (std::size_t k = 0; k < its->size(); ++k)
+      check((*its)[k], defs["interaction"]["properties"], idx("/interactions", k));
+}
+
+}  // namespace
+
 std::vector<Diagnostic> validate_document(json& doc, const std::filesystem::path& file, PluginRegistry& registry) {
   Checker ck;
   ck.file = file;
@@ -704,6 +757,7 @@ std::vector<Diagnostic> validate_document(json& doc, const std::filesystem::path
   const Filled filled(filled_list.begin(), filled_list.end());
   check_models(ck, doc, registry, filled);
   check_references(ck, doc, filled);
+  check_plausible(ck, doc);
   return ck.diags;
 }
 
@@ -740,6 +794,54 @@ std::string too_deep_at(const std::string& text) {
   return {};
 }
 
+/// Where a number beyond the range of a double stands: the JSON parser's
+/// DOM build refuses it without a position, so the text is read once more
+/// through the SAX interface, which follows the keys and indices down to it
+/// and gets the parser's line and column.
+struct OverflowLocator {
+  struct Level {
+    bool array;
+    std::size_t index;
+    std::string key;
+  };
+  std::vector<Level> levels;
+  std::string pointer;
+  std::size_t offset = std::string::npos;  ///< of the number's first character
+
+  void value() {
+    if (!levels.empty() && levels.back().array) ++levels.back().index;
+  }
+  std::string here() const {
+    std::string p;
+    for (const Level& l : levels) {
+      if (l.array) {
+        p += "/" + std::to_string(l.index);
+        continue;
+      }
+      p += "/" + escape_pointer_token(l.key);
+    }
+    return p;
+  }
+  bool null() { value(); return true; }
+  bool boolean(bool) { value(); return true; }
+  bool number_integer(json::number_integer_t) { value(); return true; }
+  bool number_unsigned(json::number_unsigned_t) { value(); return true; }
+  bool number_float(json::number_float_t, const std::string&) { value(); return true; }
+  bool string(std::string&) { value(); return true; }
+  bool binary(json::binary_t&) { value(); return true; }
+  bool start_object(std::size_t) { levels.push_back({false, 0, {}}); return true; }
+  bool key(std::string& k) { levels.back().key = k; return true; }
+  bool end_object() { levels.pop_back(); value(); return true; }
+  bool start_array(std::size_t) { levels.push_back({true, 0, {}}); return true; }
+  bool end_array() { levels.pop_back(); value(); return true; }
+  // position: the characters read, the token included (an array's index counts the values before it)
+  bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception&) {
+    pointer = here();
+    offset = position >= token.size() ? position - token.size() : 0;
+    return false;
+  }
+};
+
 json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& diags) {
   std::ifstream in(file, std::ios::binary);
   if (!in) {
@@ -766,9 +868,19 @@ json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& 
     diags.push_back({file.string(), "", "not valid JSON: " + message(e),
                      "look for a missing ',' or '\"' just before that position, or a trailing ','"});
   } catch (const json::out_of_range& e) {
-    // a number beyond the range of a double, e.g. 1e400
-    diags.push_back({file.string(), "", "not a usable number: " + message(e) + " (beyond +-1.8e308, the range of a "
-                                        "double)", "write the number in SI units within the range of a double"});
+    // a number beyond the range of a double, e.g. 1e400: where it stands
+    OverflowLocator where;
+    json::sax_parse(text, &where);
+    std::string at;
+    if (where.offset != std::string::npos && where.offset <= text.size()) {
+      const std::size_t line = 1 + std::count(text.begin(), text.begin() + where.offset, '\n');
+      const std::size_t start = text.rfind('\n', where.offset == 0 ? 0 : where.offset - 1);
+      const std::size_t column = where.offset - (start == std::string::npos || where.offset == 0 ? 0 : start + 1) + 1;
+      at = " at line " + std::to_string(line) + ", column " + std::to_string(column);
+    }
+    diags.push_back({file.string(), where.pointer, "not a usable number" + at + ": " + message(e) +
+                                                       " (beyond +-1.8e308, the range of a double)",
+                     "write the number in SI units within the range of a double"});
   } catch (const json::exception& e) {
     diags.push_back({file.string(), "", "not valid JSON: " + message(e), ""});
   }

@@ -150,6 +150,11 @@ class Subdomain {
   /// for the forces at the step's end. Without one, gravity stays the
   /// vector given to set_environment().
   void set_gravity(std::shared_ptr<const GravitySchedule> g);
+  /// The walls' primitives in their reference state (time 0; empty before set_environment()).
+  const std::vector<WallPrimitive>& reference_walls() const {
+    static const std::vector<WallPrimitive> kNone;
+    return walls_ ? *walls_ : kNone;
+  }
   /// The force [N] the particles put on scenario wall `wall` at the last
   /// force evaluation: the sum over its primitives with track_load set.
   void wall_load(std::size_t wall, double f[3]) const;

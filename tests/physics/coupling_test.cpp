@@ -27,17 +27,21 @@ namespace {
 constexpr double kD = 0.0028;  // fine diameter; coarse parcels are 2 kD
 constexpr double kPi = 3.14159265358979323846;
 
-/// A coarse level (alpha 2) filling [0, 0.06]^3 on a lattice and an empty
-/// fine level (alpha 1) coupled on the box [0, 0.06]^2 x [0, 0.03] with +z
-/// as inflow face, controllers off (they are tested on their own), a
-/// transfer at every control interval.
+/// A coarse level (alpha 2) on a lattice over [0, 0.06]^2 x [0.06, 0.12]
+/// and an empty fine level (alpha 1) coupled on the box [0, 0.06]^2 x
+/// [0, 0.03] with +z as inflow face, controllers off (they are tested on
+/// their own), a transfer at every control interval. The lattice is built
+/// above the fine region (a scenario may not start with parcels inside it);
+/// make() lowers it by kLift to fill [0, 0.06]^3, the region full of parcels
+/// as during a run.
+constexpr double kLift = 0.06;
 json two_level(double gravity = 0.0) {
   json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
   doc["gravity"] = {0, 0, gravity};
   json coarse = {{"name", "coarse"}, {"material", "m"}, {"coarse_grain", 2}, {"contact", dt::hertz_mindlin()},
                  {"time_step", 3.6e-5}};
   coarse["insert"] = {{{"model", "lattice"}, {"diameter", kD}, {"spacing", 1.05},
-                       {"region", {{"box", {{"min", {0, 0, 0}}, {"max", {0.06, 0.06, 0.06}}}}}}}};
+                       {"region", {{"box", {{"min", {0, 0, kLift}}, {"max", {0.06, 0.06, 0.06 + kLift}}}}}}}};
   json fine = {{"name", "fine"}, {"material", "m"}, {"coarse_grain", 1}, {"contact", dt::hertz_mindlin()},
                {"time_step", 1.8e-5}};
   doc["subdomains"] = {coarse, fine};
@@ -63,6 +67,7 @@ struct Levels {
 Levels make(const json& doc) {
   Levels s;
   s.sim = dt::build(doc);
+  for (double& z : s.sim->subdomains[0]->store().z) z -= kLift;
   s.sim->flow.start(s.sim->subdomains);
   s.c = s.sim->couplings.at(0).get();
   s.c->start(s.sim->subdomains, s.sim->walls, {});
