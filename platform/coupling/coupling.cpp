@@ -375,11 +375,18 @@ std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const st
           static_cast<std::uint32_t>(k));
   };
   for (std::size_t k = 0; k < s.size(); ++k) add_to_bins(k);
-  std::vector<const WallPrimitive*> active;
-  std::vector<WallPrimitive> meshes;  // their closest triangles: WallClearance
-  for (const auto& w : walls)
-    if (w.active(t) && w.shape == WallPrimitive::Shape::mesh) meshes.push_back(w);
-    else if (w.active(t)) active.push_back(&w);
+  // `walls` hold their reference state: a moving one is placed at t first
+  std::vector<WallPrimitive> at_t;
+  std::vector<WallPrimitive> meshes;  // their closest triangles: WallClearance (which places them itself)
+  for (const auto& w : walls) {
+    if (!w.active(t)) continue;
+    if (w.shape == WallPrimitive::Shape::mesh) {
+      meshes.push_back(w);
+    } else {
+      at_t.push_back(w);
+      at_t.back().place(w, t);
+    }
+  }
   const WallClearance mesh_clearance(meshes, t, rmax);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   std::size_t placed = 0;
@@ -396,8 +403,8 @@ std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const st
       }
       if (!room) break;
       ok = true;
-      for (const WallPrimitive* w : active)
-        if (w->near(p[0], p[1], p[2], r)) {
+      for (const WallPrimitive& w : at_t)
+        if (w.near(p[0], p[1], p[2], r)) {
           ok = false;
           break;
         }

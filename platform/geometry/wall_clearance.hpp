@@ -18,7 +18,10 @@
 namespace domel::platform {
 
 /// The walls that act at one time, placed there (a moving wall at its pose
-/// then), asked about spheres of radius at most `r_max`.
+/// then), asked about spheres of radius at most `r_max`. With r_max 0 (a
+/// question about points: covers()) meshes are left out: a mesh acts from
+/// both sides and holds no point. One thread at a time (overlap() keeps a
+/// scratch list).
 class WallClearance {
  public:
   WallClearance(const std::vector<WallPrimitive>& walls, double t, double r_max);

@@ -335,7 +335,7 @@ void build_couplings(Build& b) {
             b.ck.add(base + "/region", "the fine region lies outside the coarse level's domain along " +
                                            std::string(1, "xyz"[a]) + ": [" + fmt_num(s.grid.lo[a]) + ", " +
                                            fmt_num(s.grid.hi[a]) + "] m against [" + bound(lo[a]) + ", " +
-                                           bound(hi[a]) + "] m (the walls, pour, insertion and deletion regions)");
+                                           bound(hi[a]) + "] m (the walls, planes, pour, insertion and deletion regions)");
             break;
           }
     }

@@ -308,9 +308,9 @@ std::uint64_t name_hash(const std::string& name) {
 }
 
 /// True (and reported at `where`) when the region lies wholly inside the
-/// walls as they stand at the start: nothing can be placed in it.
-bool region_inside_walls(Build& b, const domel_region_v1& region, const std::string& where) {
-  const WallClearance clearance(b.sim.walls, 0.0, 0.0);
+/// walls as they stand at time t: nothing can be placed in it.
+bool region_inside_walls(Build& b, const domel_region_v1& region, double t, const std::string& where) {
+  const WallClearance clearance(b.sim.walls, t, 0.0);
   std::size_t w = 0;
   if (!clearance.covers(region, &w)) return false;
   b.ck.add(where, "the region lies wholly inside the wall '" + b.sim.walls[w].name + "' (" +
@@ -329,11 +329,11 @@ void build_insertions(Build& b, Subdomain& sub, const json& sd, const std::strin
     const std::string where = idx(base + "/insert", q);
     try {
       const Inserter ins = make_inserter(b, block, sub, b.sim.seed * 1000003ull + hash + q);
-      if (region_inside_walls(b, ins.region, where + "/region")) continue;
+      // fixed particles (a rough floor) feel no wall and may stand in one
+      if (!ins.fixed && region_inside_walls(b, ins.region, 0.0, where + "/region")) continue;
       ParticleStore& st = sub.store();
       InsertionCandidates c = request_insertion(*ins.model, ins.region, ins.seed, sub.coarse_grain(), &st,
                                                 b.sim.flow.max_particles, sub.periodic(), ins.materials.mixture());
-      // fixed particles (a rough floor) feel no wall and may stand in one
       if (const std::size_t dropped = ins.fixed ? 0 : drop_wall_overlaps(c, b.sim.walls, 0.0))
         spdlog::info("subdomain '{}': {} of the places {} chose overlap a wall and are left empty", sub.name(),
                      dropped, where);
@@ -373,7 +373,7 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
     const std::string where = idx(base + "/pour", q);
     try {
       const Inserter ins = make_inserter(b, pb["insert"], sub, b.sim.seed * 1000003ull + hash + 7919ull * (q + 1));
-      if (region_inside_walls(b, ins.region, where + "/insert/region")) continue;
+      if (!ins.fixed && region_inside_walls(b, ins.region, pb["start"].get<double>(), where + "/insert/region")) continue;
       Pour p;
       p.where = where;
       p.subdomain = b.sim.subdomains.size();
@@ -407,21 +407,23 @@ void build_pours(Build& b, Subdomain& sub, const json& sd, const std::string& ba
       }
       InsertionCandidates c = request_insertion(*p.model, p.region, p.seed, p.alpha, nullptr,
                                                 b.sim.flow.max_particles, {}, p.materials.mixture());
-      if (!p.fixed) drop_wall_overlaps(c, b.sim.walls, p.start);
       if (c.size() == 0) {
         b.ck.add(where + "/insert", "the insertion model placed no particle in the pour region",
                  "enlarge the region or raise the model's volume_fraction / count");
         continue;
       }
-      // each component's size range (one for a single material)
+      // each component's size range (one for a single material), from every size the model draws
       std::vector<PourProbe> probes(p.materials.material.size(), PourProbe{HUGE_VAL, 0.0, 0.0, 0});
-      double one_event = 0;
       for (std::size_t q = 0; q < c.size(); ++q) {
         PourProbe& pp = probes[c.component.empty() ? 0 : c.component[q]];
         pp.r_min = std::min(pp.r_min, c.r[q]);
         pp.r_max = std::max(pp.r_max, c.r[q]);
-        one_event += p.materials.density_of(c, q) * 4.0 / 3.0 * M_PI * c.r[q] * c.r[q] * c.r[q];
       }
+      // what one event can place: the places clear of the walls
+      if (!p.fixed) drop_wall_overlaps(c, b.sim.walls, p.start);
+      double one_event = 0;
+      for (std::size_t q = 0; q < c.size(); ++q)
+        one_event += p.materials.density_of(c, q) * 4.0 / 3.0 * M_PI * c.r[q] * c.r[q] * c.r[q];
       for (std::size_t k = 0; k < probes.size(); ++k)
         if (probes[k].r_max > 0) {
           probes[k].density = p.materials.density[k];

@@ -6,7 +6,8 @@
 // random insertion whose cylinder region reaches past a hopper's cone (the
 // case the issue found: overlaps of up to 78 % of a diameter) placing every
 // particle clear of the cone, checked against the cone's distance written
-// out here. Cost: well under a second.
+// out here, and a pour through the same cone placing its first event clear of
+// it; a fixed floor may stand in a wall. Cost: about a second.
 #include "geometry/wall_clearance.hpp"
 
 #include "scenario/scenario.hpp"
@@ -15,7 +16,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <unistd.h>
 #include <vector>
 
 namespace dp = domel::platform;
@@ -153,28 +156,90 @@ TEST(WallClearance, ARegionWhollyInsideTheWalls) {
   EXPECT_EQ(which, 0u);
 }
 
-TEST(WallClearance, AnInsertionReachingPastAHopperConePlacesNothingInIt) {
-  // the hopper of scenarios/examples/hopper.json (radius 4 mm at z = 0 to 20 mm at z = 30 mm) with the
-  // insertion cylinder widened to 12 mm from z = 5 mm: its lower part reaches through the cone
+namespace {
+
+/// The hopper of scenarios/examples/hopper.json (radius 4 mm at z = 0 to 20 mm at z = 30 mm).
+constexpr double kR0 = 0.004, kR1 = 0.02, kH = 0.03;
+
+/// The least clearance of the store's particles from the hopper's mantle,
+/// in radii: the signed distance from the mantle's line (kR0, 0)-(kR1, kH)
+/// in the (rho, z) half-plane, positive inside, less the radius.
+double least_cone_clearance(const dp::ParticleStore& s) {
+  const double len = std::hypot(kR1 - kR0, kH);
+  double closest = INFINITY;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const double rho = std::hypot(s.x[k], s.y[k]);
+    const double d = ((kR0 - rho) * kH + s.z[k] * (kR1 - kR0)) / len;
+    closest = std::min(closest, (d - s.radius[k]) / s.radius[k]);
+  }
+  return closest;
+}
+
+/// That hopper, and a cylinder region 12 mm wide from z = 5 mm: its lower part reaches through the cone.
+nlohmann::json hopper_reached_through() {
   nlohmann::json doc = dt::scenario(dt::hertz_mindlin(), 1e-5, 0.5, 0.5);
   doc["gravity"] = {0, 0, -9.81};
-  const double r0 = 0.004, r1 = 0.02, h = 0.03;
   doc["walls"] = {{{"name", "hopper"}, {"type", "cone"}, {"material", "m"}, {"axis", "z"}, {"center", {0, 0, 0}},
-                   {"bottom", 0.0}, {"top", h}, {"radius_bottom", r0}, {"radius_top", r1}, {"closed_bottom", true}}};
-  doc["subdomains"][0]["insert"] = {{{"model", "random"}, {"diameter", 0.0014}, {"count", 300}, {"seed", 7},
-                                     {"region", {{"cylinder", {{"axis", "z"}, {"center", {0, 0, 0}}, {"radius", 0.012},
-                                                               {"bottom", 0.005}, {"top", h}}}}}}};
+                   {"bottom", 0.0}, {"top", kH}, {"radius_bottom", kR0}, {"radius_top", kR1}, {"closed_bottom", true}}};
+  return doc;
+}
+
+const nlohmann::json kWideRegion = {
+    {"cylinder", {{"axis", "z"}, {"center", {0, 0, 0}}, {"radius", 0.012}, {"bottom", 0.005}, {"top", kH}}}};
+
+}  // namespace
+
+TEST(WallClearance, APourReachingPastAHopperConePlacesNothingInIt) {
+  nlohmann::json doc = hopper_reached_through();
+  doc["subdomains"][0]["pour"] = {{{"insert", {{"model", "random"}, {"diameter", 0.0014}, {"volume_fraction", 0.2},
+                                               {"region", kWideRegion}}},
+                                   {"mass_rate", 0.5}, {"interval", 0.01}}};
+  auto sim = dt::build(doc);
+  dp::RunOptions opt;
+  opt.progress = false;
+  opt.max_steps = 1;  // the first event, then one step of 1e-5 s (far less than 1e-3 r of motion)
+  opt.output_directory = std::filesystem::temp_directory_path() / ("domel_wall_clearance_" + std::to_string(getpid()));
+  sim->run(opt, dt::builtin_registry());
+  std::filesystem::remove_all(opt.output_directory);
+  const dp::ParticleStore& s = sim->subdomains[0]->store();
+  ASSERT_GT(s.size(), 50u);
+  const double closest = least_cone_clearance(s);
+  std::printf("[hopper pour] %zu particles, least clearance from the cone %.3g radii\n", s.size(), closest);
+  EXPECT_GE(closest, -1e-3);
+}
+
+TEST(WallClearance, AFixedFloorMayStandInAWall) {
+  // a rough floor of fixed particles on a lattice across the whole box under a can: those outside the can's
+  // mantle stand in its wall (they feel none), and a region wholly outside it is no error either
+  nlohmann::json doc = hopper_reached_through();
+  doc["walls"] = {{{"name", "can"}, {"type", "cylinder"}, {"material", "m"}, {"axis", "z"}, {"center", {0, 0, 0}},
+                   {"radius", 0.01}, {"bottom", 0.0}, {"top", 0.05}, {"closed_bottom", false}}};
+  const nlohmann::json floor_everywhere = {{"box", {{"min", {-0.02, -0.02, 0}}, {"max", {0.02, 0.02, 0.0014}}}}};
+  const nlohmann::json floor_outside = {{"box", {{"min", {0.012, 0.012, 0.0014}}, {"max", {0.02, 0.02, 0.0028}}}}};
+  doc["subdomains"][0]["insert"] = {
+      {{"model", "lattice"}, {"diameter", 0.0014}, {"fixed", true}, {"region", floor_everywhere}},
+      {{"model", "lattice"}, {"diameter", 0.0014}, {"fixed", true}, {"region", floor_outside}}};
+  const auto sim = dt::build(doc);
+  const dp::ParticleStore& s = sim->subdomains[0]->store();
+  std::size_t in_the_wall = 0;
+  for (std::size_t k = 0; k < s.size(); ++k) in_the_wall += std::hypot(s.x[k], s.y[k]) > 0.01 ? 1 : 0;
+  // the lattice's sites: region minimum + (i + 0.5) d (plugins/insertion/lattice.hpp), 28 per side here
+  std::size_t inside = 0, sites = 0;
+  for (int i = 0; i < 28; ++i)
+    for (int j = 0; j < 28; ++j, ++sites)
+      inside += std::hypot(-0.02 + (i + 0.5) * 0.0014, -0.02 + (j + 0.5) * 0.0014) > 0.01 ? 0 : 1;
+  EXPECT_EQ(s.size() - in_the_wall, inside);          // the first layer's sites inside the can
+  EXPECT_GT(in_the_wall, sites - inside + 20);        // the rest of it in the wall, and the second region's
+}
+
+TEST(WallClearance, AnInsertionReachingPastAHopperConePlacesNothingInIt) {
+  nlohmann::json doc = hopper_reached_through();
+  doc["subdomains"][0]["insert"] = {
+      {{"model", "random"}, {"diameter", 0.0014}, {"count", 300}, {"seed", 7}, {"region", kWideRegion}}};
   const auto sim = dt::build(doc);
   const dp::ParticleStore& s = sim->subdomains[0]->store();
   ASSERT_GT(s.size(), 100u);
-  const double len = std::hypot(r1 - r0, h);
-  double closest = INFINITY;  // the least clearance, distance from the mantle less the radius, over r
-  for (std::size_t k = 0; k < s.size(); ++k) {
-    const double rho = std::hypot(s.x[k], s.y[k]);
-    // signed distance from the mantle's line (r0, 0)-(r1, h) in the (rho, z) half-plane, positive inside
-    const double d = ((r0 - rho) * h + s.z[k] * (r1 - r0)) / len;
-    closest = std::min(closest, (d - s.radius[k]) / s.radius[k]);
-  }
+  const double closest = least_cone_clearance(s);
   std::printf("[hopper insertion] %zu particles, least clearance from the cone %.3g radii\n", s.size(), closest);
   EXPECT_GE(closest, -1e-9);  // round-off of the two distance formulas
 }
