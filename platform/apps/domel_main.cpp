@@ -18,12 +18,14 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <thread>
 
 #include <unistd.h>
@@ -160,7 +162,11 @@ void load_default_plugins(dp::PluginRegistry& registry) {
 /// of a checkpoint).
 std::string g_deferred_problems;
 
-void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
+/// True when every rank of the run ended with the same code by agreement
+/// (agree_on_scenario()): main() ends them normally, without MPI_Abort.
+bool g_ranks_agreed = false;
+
+std::string diagnostics_text(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
   std::string text = "domel: " + what + " has " + std::to_string(diags.size()) + " problem" +
                      (diags.size() == 1 ? "" : "s") + ":\n";
   for (const auto& d : diags) {
@@ -172,9 +178,98 @@ void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic
     if (!d.hint.empty()) line += " (" + d.hint + ")";
     text += line + "\n";
   }
+  return text;
+}
+
+void print_diagnostics(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
+  const std::string text = diagnostics_text(what, diags);
   // every rank read the same scenario: rank 0 says it once
   if (world().rank() == 0) std::fputs(text.c_str(), stderr);
   else g_deferred_problems = "(rank " + std::to_string(world().rank()) + ") " + text;
+}
+
+/// The plugins a rank loaded (name, version, ABI of each library, sorted)
+/// and the libraries it refused: what must be the same on every rank.
+std::string plugin_view(const dp::PluginRegistry& registry) {
+  std::vector<std::string> lines;
+  for (const auto& lib : registry.libraries())
+    lines.push_back(lib.name + " " + lib.version + " (ABI " + std::to_string(lib.abi_major) + "." +
+                    std::to_string(lib.abi_minor) + ")");
+  for (const auto& r : registry.refused()) lines.push_back(r);
+  std::sort(lines.begin(), lines.end());
+  std::string view;
+  for (const auto& l : lines) view += "    " + l + "\n";
+  return view;
+}
+
+/// "0, 2" for the ranks in `ranks`.
+std::string rank_list(const std::vector<int>& ranks) {
+  std::string s;
+  for (std::size_t k = 0; k < ranks.size(); ++k) s += (k ? ", " : "") + std::to_string(ranks[k]);
+  return s;
+}
+
+/// Under mpirun, before anything is run or written: every rank must have
+/// loaded the same plugins and come to the same verdict on the scenario (a
+/// plugin or state file that one node's file system holds damaged, another
+/// version of a plugin on one node). Every rank learns what every rank
+/// found; rank 0 reports where they differ. Returns 0 when every rank may
+/// run, else kExitRefused on every rank alike.
+int agree_on_scenario(const std::string& scenario, const dp::PluginRegistry& registry,
+                      const std::vector<dp::Diagnostic>& problems) {
+  const std::string mine = plugin_view(registry) + "\x1f" +
+                           (problems.empty() ? std::string() : diagnostics_text(scenario, problems));
+  const auto all = world().all_gather(std::vector<char>(mine.begin(), mine.end()));
+  std::map<std::string, std::vector<int>> views, verdicts;  // text -> ranks
+  bool any_refused = false;
+  for (int r = 0; r < static_cast<int>(all.size()); ++r) {
+    const std::string text(all[r].begin(), all[r].end());
+    const std::size_t cut = text.find('\x1f');
+    views[text.substr(0, cut)].push_back(r);
+    const std::string verdict = cut == std::string::npos ? "" : text.substr(cut + 1);
+    verdicts[verdict].push_back(r);
+    any_refused = any_refused || !verdict.empty();
+  }
+  if (views.size() == 1 && !any_refused) return 0;
+  g_ranks_agreed = true;
+  if (world().rank() != 0) return kExitRefused;
+  std::string text;
+  if (views.size() > 1) {
+    // each view's lines that not every rank has
+    auto lines_of = [](const std::string& view) {
+      std::vector<std::string> lines;
+      std::istringstream in(view);
+      for (std::string l; std::getline(in, l);) lines.push_back(l);
+      return lines;
+    };
+    std::map<std::string, std::size_t> seen;
+    for (const auto& v : views)
+      for (const auto& l : lines_of(v.first)) ++seen[l];
+    std::size_t common = 0;
+    for (const auto& [l, n] : seen) common += n == views.size();
+    text += "domel: the ranks do not load the same plugins, so they would not run the same models (besides the " +
+            std::to_string(common) + " every rank loaded):\n";
+    for (const auto& [view, ranks] : views) {
+      text += "  rank" + std::string(ranks.size() > 1 ? "s " : " ") + rank_list(ranks) + ":\n";
+      std::size_t own = 0;
+      for (const auto& l : lines_of(view))
+        if (seen[l] < views.size()) text += l + "\n", ++own;
+      if (own == 0) text += "    (nothing else)\n";
+    }
+    text += "  (the same plugin folders, $DOMEL_PLUGIN_PATH and plugin files on every node)\n";
+  }
+  if (verdicts.size() == 1) {
+    text += verdicts.begin()->first;  // every rank refused the scenario alike
+  } else {
+    for (const auto& [verdict, ranks] : verdicts) {
+      if (verdict.empty()) continue;
+      text += "on rank" + std::string(ranks.size() > 1 ? "s " : " ") + rank_list(ranks) + " (the others accepted it: " +
+              "a file the scenario names differs between the ranks' views) " + verdict;
+    }
+  }
+  std::fputs(text.c_str(), stderr);
+  std::fprintf(stderr, "nothing was run and nothing was written.\n");
+  return kExitRefused;
 }
 
 /// SIGINT and SIGTERM ask the run to stop after its current step
@@ -236,11 +331,17 @@ int cmd_run(int argc, char** argv) {
   dp::PluginRegistry registry;
   load_default_plugins(registry);
   std::unique_ptr<dp::Simulation> sim;
+  std::vector<dp::Diagnostic> problems;
   try {
     sim = dp::load_scenario(a.positional[0], registry);
   } catch (const dp::ConfigError& e) {
-    print_diagnostics(a.positional[0], e.diagnostics());
-    if (world().rank() == 0) std::fprintf(stderr, "nothing was run and nothing was written.\n");
+    problems = e.diagnostics();
+  }
+  if (world().size() > 1) {
+    if (const int code = agree_on_scenario(a.positional[0], registry, problems)) return code;
+  } else if (!problems.empty()) {
+    print_diagnostics(a.positional[0], problems);
+    std::fprintf(stderr, "nothing was run and nothing was written.\n");
     return kExitRefused;
   }
   try {
@@ -275,8 +376,15 @@ int cmd_run(int argc, char** argv) {
     }
   } catch (const std::exception& e) {
     const std::string where = world().size() > 1 ? " on rank " + std::to_string(world().rank()) : "";
+    std::string then;
+    if (const auto& ck = sim->last_checkpoint())
+      then = "the last checkpoint, of t = " + fmt::format("{:.6g}", ck->time) + " s, is intact; continue with: domel run " +
+             a.positional[0] + " --restart " + ck->file.string();
+    else
+      then = "no checkpoint was written (run.checkpoint_interval)";
     std::fprintf(stderr, "domel: the run of %s failed%s: %s\nFiles written before the failure are complete; "
-                         "summary.json was not written.\n", a.positional[0].c_str(), where.c_str(), e.what());
+                         "summary.json was not written; %s\n", a.positional[0].c_str(), where.c_str(), e.what(),
+                 then.c_str());
     return kExitRunFailed;
   }
   return 0;
@@ -431,6 +539,10 @@ int dispatch(int argc, char** argv);
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file size limit (ulimit -f, a batch system's quota) would end the
+  // process with SIGXFSZ in the middle of a write; ignored, the write fails
+  // with EFBIG and the run ends with the file's name and the last checkpoint.
+  std::signal(SIGXFSZ, SIG_IGN);
   auto logger = spdlog::stderr_color_mt("domel");
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("%^[%l]%$ %v");
@@ -441,12 +553,14 @@ int main(int argc, char** argv) {
   if (world().rank() != 0) spdlog::set_level(spdlog::level::err);
   const int code = dispatch(argc, argv);
   // a failure on one rank ends every rank (the others may wait in a
-  // collective). A refused scenario is refused alike on every rank, and rank
+  // collective). A scenario or a plugin refused on any rank was refused on
+  // every rank together (agree_on_scenario): they end normally. A refusal
+  // later (while the run is set up) is refused alike on every rank, and rank
   // 0 reports it: the others give it a second to do so before ending the run.
   // A run stopped by a signal stopped on every rank at the same macro step
   // and wrote its checkpoint together: the ranks end normally.
   const bool stopped = code == 128 + SIGINT || code == 128 + SIGTERM;
-  if (code != 0 && world().size() > 1 && !stopped) {
+  if (code != 0 && world().size() > 1 && !stopped && !g_ranks_agreed) {
     if (code == kExitRefused && world().rank() != 0) {
       std::this_thread::sleep_for(std::chrono::seconds(1));
       // still here: rank 0 did not refuse the run, so the problem is this rank's own

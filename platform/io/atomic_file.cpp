@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string reason(int err) { return std::error_code(err, std::generic_category()).message(); }
+std::string reason(int err) { return disk_full_reason(err); }
 
 [[noreturn]] void fail(const fs::path& path, const std::string& what) {
   throw RuntimeError("cannot write file '" + path.string() + "': " + what);
@@ -37,6 +37,13 @@ fs::path temporary_path_for(const fs::path& path) {
 }
 
 }  // namespace
+
+std::string disk_full_reason(int err) {
+  const std::string text = std::error_code(err, std::generic_category()).message();
+  if (err == ENOSPC) return text + " (the disk is full)";
+  if (err == EFBIG) return text + " (the file size limit, ulimit -f, was reached)";
+  return text;
+}
 
 void write_file_atomically(const fs::path& path, const std::string& contents) {
   if (path.empty() || !path.has_filename()) fail(path, "not a file path");

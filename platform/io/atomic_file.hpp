@@ -19,4 +19,9 @@ namespace domel::platform::io {
 /// (they would share the temporary name).
 void write_file_atomically(const std::filesystem::path& path, const std::string& contents);
 
+/// The reason for a failed write (errno `err`) in the user's words: a full
+/// disk (ENOSPC) and a file size limit (EFBIG: ulimit -f, a batch system's
+/// quota) say so.
+std::string disk_full_reason(int err);
+
 }  // namespace domel::platform::io

@@ -44,7 +44,7 @@ void append_to(const std::filesystem::path& path, const std::string& text) {
     const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      const std::string why = std::strerror(errno);
+      const std::string why = disk_full_reason(errno);
       ::close(fd);
       // the part written stays; cut it off so that the file ends with a whole row
       std::error_code ec;

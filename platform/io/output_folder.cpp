@@ -4,6 +4,7 @@
 #include "io/output_folder.hpp"
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +16,7 @@
 #include <set>
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 namespace domel::platform::io {
@@ -50,7 +52,7 @@ void append_line(const fs::path& file, const std::string& line) {
   const int err = errno;
   ::close(fd);
   if (n != static_cast<ssize_t>(text.size()))
-    throw RuntimeError("cannot write file '" + file.string() + "': " + std::strerror(err));
+    throw RuntimeError("cannot write file '" + file.string() + "': " + disk_full_reason(err ? err : EIO));
 }
 
 /// A manifest line that names a file inside the folder (no absolute path,
@@ -161,10 +163,43 @@ std::vector<std::string> manifest_entries(const fs::path& folder) {
   return entries;
 }
 
+namespace {
+
+/// The temporary files a process killed in the middle of writing left
+/// (`NAME.tmp-PID`, io/atomic_file.hpp and io/vtk_frames.hpp) for the files
+/// the manifest lists, the writing process gone. Returns how many.
+std::size_t remove_orphaned_temporaries(const fs::path& folder, const std::vector<std::string>& listed) {
+  std::set<fs::path> dirs;
+  for (const auto& e : listed) dirs.insert((folder / e).parent_path());
+  const std::set<std::string> names(listed.begin(), listed.end());
+  std::size_t removed = 0;
+  for (const auto& dir : dirs) {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string file = it->path().filename().string();
+      const std::size_t at = file.rfind(".tmp-");
+      if (at == std::string::npos || at + 5 == file.size() ||
+          file.find_first_not_of("0123456789", at + 5) != std::string::npos)
+        continue;
+      const fs::path target = it->path().parent_path() / file.substr(0, at);
+      if (!names.count(target.lexically_relative(folder).string())) continue;
+      const long pid = std::stol(file.substr(at + 5));
+      if (pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)) continue;  // still writing
+      std::error_code rm;
+      if (fs::remove(it->path(), rm)) ++removed;
+    }
+  }
+  return removed;
+}
+
+}  // namespace
+
 void prepare_output_folder(const fs::path& folder, OutputPolicy policy) {
-  if (policy == OutputPolicy::restart || !fs::is_directory(folder)) return;
+  if (!fs::is_directory(folder)) return;
   const bool has_manifest = fs::exists(folder / kManifestFile);
   const std::vector<std::string> listed = manifest_entries(folder);
+  if (policy != OutputPolicy::fresh) remove_orphaned_temporaries(folder, listed);
+  if (policy == OutputPolicy::restart) return;
   const std::vector<std::string> known = known_outputs(folder);
   if (!has_manifest && known.empty()) return;  // nothing of a run's there
   auto refuse = [&](const std::string& what) {

@@ -49,7 +49,9 @@ enum class OutputPolicy {
 /// run writes); with `overwrite`, removes every file the manifest lists (and
 /// the manifest) or, for a folder written by a domel older than the manifest,
 /// the fixed names, the files its summary.json lists under "outputs" and the
-/// frames of those .pvd collections; with `restart`, does nothing.
+/// frames of those .pvd collections; with `restart`, keeps them. With
+/// `overwrite` and `restart`, first removes the temporary files
+/// (`NAME.tmp-PID`) that a process killed while writing a listed file left.
 void prepare_output_folder(const std::filesystem::path& folder, OutputPolicy policy);
 
 }  // namespace domel::platform::io

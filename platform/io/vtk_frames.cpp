@@ -7,10 +7,17 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 
+#include <vtkErrorCode.h>
+#include <vtkLogger.h>
+#include <vtkNew.h>
+#include <vtkOutputWindow.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringOutputWindow.h>
 #include <vtkXMLWriter.h>
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <system_error>
@@ -42,6 +49,32 @@ std::string xml_attribute(const std::string& s) {
     }
   }
   return out;
+}
+
+/// Why a VTK writer failed, in the user's words (its error code is an errno
+/// below vtkErrorCode::FirstVTKErrorCode, else VTK's own).
+std::string vtk_reason(unsigned long code) {
+  if (code == vtkErrorCode::OutOfDiskSpaceError)  // VTK's name for any failed write of its stream
+    return "the disk is full or the file size limit (ulimit -f) was reached";
+  if (code > 0 && code < vtkErrorCode::FirstVTKErrorCode) return disk_full_reason(static_cast<int>(code));
+  if (code == vtkErrorCode::NoError) return "the writer failed";
+  const char* name = vtkErrorCode::GetStringFromErrorCode(code);
+  return std::string("VTK's ") + (name ? name : "unknown error");
+}
+
+/// Runs the writer with VTK's own report of a failure silenced (a dozen
+/// lines from its pipeline on stderr; the caller reports it in one line);
+/// returns Write()'s result.
+int quietly(vtkXMLWriter& writer) {
+  const vtkLogger::Verbosity before = vtkLogger::GetCurrentVerbosityCutoff();
+  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+  vtkSmartPointer<vtkOutputWindow> previous = vtkOutputWindow::GetInstance();
+  vtkNew<vtkStringOutputWindow> capture;
+  vtkOutputWindow::SetInstance(capture);
+  const int ok = writer.Write();
+  vtkOutputWindow::SetInstance(previous);
+  vtkLogger::SetStderrVerbosity(before);
+  return ok;
 }
 
 }  // namespace
@@ -86,10 +119,10 @@ fs::path VtkFrames::write(vtkXMLWriter& writer, double time) {
   writer.EncodeAppendedDataOff();  // raw binary, not base64
   writer.SetCompressorTypeToZLib();
   writer.SetHeaderTypeToUInt64();
-  const int ok = writer.Write();
+  const int ok = quietly(writer);
   if (ok != 1 || writer.GetErrorCode() != 0) {
     fs::remove(tmp, ec);
-    throw RuntimeError("cannot write file '" + target.string() + "': " + writer.GetClassName() + " failed");
+    throw RuntimeError("cannot write file '" + target.string() + "': " + vtk_reason(writer.GetErrorCode()));
   }
   fs::rename(tmp, target, ec);
   if (ec) {

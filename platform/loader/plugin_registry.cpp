@@ -8,11 +8,15 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <fstream>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <sstream>
 #include <type_traits>
+
+#include <elf.h>
 
 namespace domel::platform {
 
@@ -42,6 +46,40 @@ const std::string kRuntimeAbi = std::to_string(DOMEL_ABI_MAJOR) + "." + std::to_
   throw PluginError("plugin '" + file.string() + "' refused: " + why);
 }
 
+/// A 64-bit ELF file whose headers reach past its end (a copy cut short, a
+/// file still being written) is refused before dlopen: the dynamic loader
+/// maps the segments its program headers name, and touching the pages past
+/// the end of the file raises SIGBUS in the host (a plugin truncated to
+/// 3,000 bytes did). Other files are left to dlopen, which refuses what it
+/// cannot load with a message.
+void refuse_cut_short_elf(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  Elf64_Ehdr eh{};
+  if (!in.read(reinterpret_cast<char*>(&eh), sizeof eh)) return;  // too short to be an ELF: dlopen says so
+  if (std::memcmp(eh.e_ident, ELFMAG, SELFMAG) != 0 || eh.e_ident[EI_CLASS] != ELFCLASS64) return;
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(file, ec);
+  if (ec) return;
+  auto reach = [&](std::uint64_t offset, std::uint64_t count, std::uint64_t each, const char* what) {
+    if (count == 0) return;
+    if (offset > size || each == 0 || count > (size - offset) / each)
+      refuse(file, std::string("the file is cut short: its ELF ") + what + " reach past its end (" +
+                       std::to_string(size) + " bytes); a copy that did not finish?");
+  };
+  reach(eh.e_phoff, eh.e_phnum, eh.e_phentsize, "program headers");
+  if (eh.e_shoff != 0) reach(eh.e_shoff, eh.e_shnum, eh.e_shentsize, "section headers");
+  if (eh.e_phentsize != sizeof(Elf64_Phdr)) return;  // dlopen refuses it
+  in.seekg(static_cast<std::streamoff>(eh.e_phoff));
+  for (unsigned k = 0; k < eh.e_phnum; ++k) {
+    Elf64_Phdr ph{};
+    if (!in.read(reinterpret_cast<char*>(&ph), sizeof ph)) return;
+    if (ph.p_filesz > 0 && (ph.p_offset > size || ph.p_filesz > size - ph.p_offset))
+      refuse(file, "the file is cut short: its ELF segment " + std::to_string(k) + " reaches byte " +
+                       std::to_string(ph.p_offset + ph.p_filesz) + " of a file of " + std::to_string(size) +
+                       " bytes; a copy that did not finish?");
+  }
+}
+
 }  // namespace
 
 const char* kind_name(uint32_t kind) {
@@ -69,6 +107,7 @@ void PluginRegistry::load(const std::filesystem::path& path) {
     if (lib.path == file) return;
   if (!std::filesystem::exists(file)) refuse(file, "file not found");
 
+  refuse_cut_short_elf(file);
   boost::dll::shared_library handle;
   try {
     handle.load(boost::dll::fs::path(file.string()),

@@ -133,6 +133,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
   if (!options.restart.empty()) {
     if (!checkpoints_possible) throw ConfigError({Diagnostic{scenario_file.string(), "", "cannot restart: " + why_not, ""}});
     ck = open_checkpoint(options.restart, world());
+    last_checkpoint_ = CheckpointMark{options.restart, ck->loop.time};
     for (const auto& c : ck->allowed_changes) spdlog::info("restart: scenario changed, allowed: {}", c);
   }
   if (checkpoint_interval > 0 && !checkpoints_possible)
@@ -175,6 +176,7 @@ RunResult Simulation::run(const RunOptions& options, const PluginRegistry& regis
       for (Component* c : components)
         if (!c->section().empty()) c->save(w, c->section());
     }, ranks);
+    last_checkpoint_ = CheckpointMark{out / kCheckpointFile, ls.time};
     spdlog::debug("checkpoint at t = {:.6g} s written in {:.3g} s", ls.time,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   };

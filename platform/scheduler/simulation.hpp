@@ -124,6 +124,15 @@ class Simulation {
   /// file written up to then is complete (written to a temporary name and renamed).
   RunResult run(const RunOptions& options, const PluginRegistry& registry);
 
+  /// A checkpoint a run can go on from: where, and the time it holds.
+  struct CheckpointMark {
+    std::filesystem::path file;
+    double time = 0;  ///< [s]
+  };
+  /// The newest checkpoint run() wrote, or the one it restarted from: after
+  /// a failure (a full disk, a blow-up) the run can go on from it.
+  const std::optional<CheckpointMark>& last_checkpoint() const { return last_checkpoint_; }
+
   /// Why this run cannot be checkpointed ("" if it can): a controller or
   /// fluid coupler whose library lacks ABI 2.3's save_state and load_state.
   std::string why_no_checkpoint() const;
@@ -146,6 +155,7 @@ class Simulation {
                          const PluginRegistry& registry, const std::vector<RankGroup>& groups, int threads,
                          std::size_t particles_at_start) const;
   std::vector<std::unique_ptr<Component>> owned_;
+  std::optional<CheckpointMark> last_checkpoint_;
 };
 
 }  // namespace domel::platform

@@ -26,6 +26,8 @@
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
+#include <iterator>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -276,6 +278,30 @@ TEST(AbiLoader, RefusesMissingFile) {
   PluginRegistry registry;
   const std::string m = refusal(registry, broken("does_not_exist"));
   EXPECT_CONTAINS(m, "not found");
+}
+
+// A plugin file cut short (a copy that did not finish, or one node's damaged
+// copy) is refused naming the cut: dlopen would map the segments its headers
+// name past the end of the file, and the first touch raised SIGBUS in the
+// host (a copy cut to 3,000 bytes did). Cut at the start of its sections, in
+// the middle and one byte short of its end.
+TEST(AbiLoader, RefusesALibraryCutShortInsteadOfCrashing) {
+  const fs::path whole = good("good_plugin");
+  const auto size = fs::file_size(whole);
+  std::ifstream in(whole, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const fs::path dir = fs::temp_directory_path() / ("domel_cut_plugin_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const std::uintmax_t cut : {std::uintmax_t{3000}, size / 2, size - 1}) {
+    SCOPED_TRACE("cut to " + std::to_string(cut) + " of " + std::to_string(size) + " bytes");
+    const fs::path file = dir / ("libcut_" + std::to_string(cut) + ".so");
+    std::ofstream(file, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(cut));
+    PluginRegistry registry;
+    const std::string m = refusal(registry, file);
+    EXPECT_CONTAINS(m, "cut short");
+    EXPECT_TRUE(registry.models().empty());
+  }
+  fs::remove_all(dir);
 }
 
 // Guards case (k): create() refusing bad parameters becomes PluginError with the model name and the plugin's message.
