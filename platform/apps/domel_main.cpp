@@ -165,6 +165,9 @@ std::string g_deferred_problems;
 /// True when every rank of the run ended with the same code by agreement
 /// (agree_on_scenario()): main() ends them normally, without MPI_Abort.
 bool g_ranks_agreed = false;
+/// True when a stop request ended the run inside a macro step (the ranks
+/// did not stop together): main() ends the others with MPI_Abort.
+bool g_stopped_mid_step = false;
 
 std::string diagnostics_text(const std::string& what, const std::vector<dp::Diagnostic>& diags) {
   std::string text = "domel: " + what + " has " + std::to_string(diags.size()) + " problem" +
@@ -376,6 +379,20 @@ int cmd_run(int argc, char** argv) {
     }
   } catch (const std::exception& e) {
     const std::string where = world().size() > 1 ? " on rank " + std::to_string(world().rank()) : "";
+    if (const int sig = dp::interrupt_requested(); sig != 0 && dp::stop_overdue()) {
+      // a loop inside the step gave up on the stop request (core/interrupt.hpp), or failed while it waited
+      std::string then = "nothing of the unfinished step was written";
+      if (const auto& ck = sim->last_checkpoint())
+        then += "; the last checkpoint, of t = " + fmt::format("{:.6g}", ck->time) +
+                " s, is intact; continue with: domel run " + a.positional[0] + " --restart " + ck->file.string();
+      else
+        then += "; no checkpoint was written";
+      std::fprintf(stderr, "domel: interrupted%s in the middle of a macro step that did not end within %.0f s of "
+                           "the request: %s\n%s; summary.json was not written\n",
+                   where.c_str(), dp::kStopGraceSeconds, e.what(), then.c_str());
+      g_stopped_mid_step = true;
+      return 128 + sig;
+    }
     std::string then;
     if (const auto& ck = sim->last_checkpoint())
       then = "the last checkpoint, of t = " + fmt::format("{:.6g}", ck->time) + " s, is intact; continue with: domel run " +
@@ -559,7 +576,7 @@ int main(int argc, char** argv) {
   // 0 reports it: the others give it a second to do so before ending the run.
   // A run stopped by a signal stopped on every rank at the same macro step
   // and wrote its checkpoint together: the ranks end normally.
-  const bool stopped = code == 128 + SIGINT || code == 128 + SIGTERM;
+  const bool stopped = (code == 128 + SIGINT || code == 128 + SIGTERM) && !g_stopped_mid_step;
   if (code != 0 && world().size() > 1 && !stopped && !g_ranks_agreed) {
     if (code == kExitRefused && world().rank() != 0) {
       std::this_thread::sleep_for(std::chrono::seconds(1));

@@ -8,6 +8,8 @@
 // read top to bottom the file is the exchange as physics.md §5-§6 gives it.
 #include "coupling/coupling.hpp"
 
+#include "core/interrupt.hpp"
+
 #include "core/abi_views.hpp"
 
 #include "core/archive.hpp"
@@ -390,11 +392,13 @@ std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const st
   const WallClearance mesh_clearance(meshes, t, rmax);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   std::size_t placed = 0;
+  std::size_t tried = 0;  // attempts of this transfer: a stop request is looked at every 4096
   while (!fb.queue.empty()) {
     const double r = fb.queue.front();
     bool ok = false;
     double p[3];
     for (int attempt = 0; attempt < spec_.attempts && !ok; ++attempt) {
+      if ((++tried & 4095) == 0) stop_point("the inflow of coupling '" + spec_.name + "'");
       bool room = true;
       for (int a = 0; a < 3; ++a) {
         const double a0 = lo[a] + r, a1 = hi[a] - r;

@@ -4,6 +4,8 @@
 // ABI version, then each required member by name.
 #include "loader/plugin_registry.hpp"
 
+#include "core/interrupt.hpp"
+
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <spdlog/spdlog.h>
 
@@ -347,6 +349,7 @@ struct ModelInstance::HostContext {
     std::lock_guard<std::mutex> lock(c->mutex);
     c->last_error = m;
   }
+  static int stop_requested(void*) { return stop_overdue() ? 1 : 0; }
 };
 
 ModelInstance::ModelInstance(const RegisteredModel& model, const nlohmann::json& params,
@@ -354,7 +357,8 @@ ModelInstance::ModelInstance(const RegisteredModel& model, const nlohmann::json&
     : model_(&model), host_(std::make_unique<HostContext>()) {
   host_->prefix = std::string(kind_name(model.desc.kind)) + " model '" + model.name + "' (library '" +
                   model.library_name + "')" + (where.empty() ? std::string() : " at " + where);
-  host_->host = {sizeof(domel_host_v2), DOMEL_ABI_MINOR, host_.get(), &HostContext::log, &HostContext::error};
+  host_->host = {sizeof(domel_host_v2), DOMEL_ABI_MINOR, host_.get(), &HostContext::log, &HostContext::error,
+                 &HostContext::stop_requested};
   char err[1024] = {0};
   const std::string text = params.dump();
   const domel_status st = model.desc.create(text.c_str(), &host_->host, &handle_, err, sizeof err);

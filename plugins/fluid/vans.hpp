@@ -316,6 +316,10 @@ class Vans {
     }
     const double dt = ex.interval / substeps_;
     for (int s = 0; s < substeps_; ++s) {
+      if (s > 0 && host_.stop_requested())
+        throw sdk::StopRequested("vans: stopped on request after " + std::to_string(s) + " of " +
+                                 std::to_string(substeps_) + " fluid steps of the exchange at t = " +
+                                 std::to_string(ex.time) + " s");
       last_solve_ = f.step(dt, static_cast<double>(s) / substeps_, static_cast<double>(s + 1) / substeps_, solve_);
     }
     ++exchanges_;

@@ -75,7 +75,7 @@ class RandomFill {
 })json";
 
   explicit RandomFill(const sdk::Params& p)
-      : d_min_(p.has("distribution") ? 1.0 : p.number("diameter")), d_max_(p.number_or("diameter_max", d_min_)) {
+      : host_(p.host()), d_min_(p.has("distribution") ? 1.0 : p.number("diameter")), d_max_(p.number_or("diameter_max", d_min_)) {
     if (p.has("distribution")) {
       if (p.has("diameter") || p.has("diameter_max"))
         throw sdk::ParameterError("random: give either 'distribution' or 'diameter' (and 'diameter_max'), not both");
@@ -147,13 +147,17 @@ class RandomFill {
       std::sort(drawn.begin(), drawn.end(), [](const auto& a, const auto& b) { return a.diameter > b.diameter; });
     }
     dest.x.reserve(target); dest.y.reserve(target); dest.z.reserve(target); dest.r.reserve(target);
-    double solid = 0.0;  // volume of the spheres placed so far
+    double solid = 0.0;     // volume of the spheres placed so far
+    std::size_t tried = 0;  // attempts so far: a stop request is looked at every 4096
     for (std::size_t n = 0; n < target; ++n) {
       const double d = has_distribution_ ? drawn[n].diameter : d_hi > d_lo ? d_lo + (d_hi - d_lo) * unit(rng) : d_lo;
       const double r = 0.5 * d;
       check_fits(g, r);
       bool placed = false;
       for (std::size_t attempt = 0; attempt < max_attempts_ && !placed; ++attempt) {
+        if ((++tried & 4095) == 0 && host_.stop_requested())
+          throw sdk::StopRequested("random: stopped on request after placing " + std::to_string(n) + " of " +
+                                   std::to_string(target) + " particles");
         double p[3];
         draw_centre(g, r, rng, unit, p);
         if (grid.overlaps(p[0], p[1], p[2], r)) continue;
@@ -244,6 +248,7 @@ class RandomFill {
     for (int k = 0; k < 3; ++k) p[k] = g.lo[k] + r + (g.hi[k] - g.lo[k] - 2.0 * r) * unit(rng);
   }
 
+  sdk::Host host_;
   double d_min_;
   double d_max_;
   sdk::SizeDistribution distribution_;

@@ -34,6 +34,11 @@ skipped (a build without MPI).
    whole for rank 0 and cut short (3,000 bytes: dlopen of it raised SIGBUS)
    for ranks 1 and 2: refused on every rank with exit 2, rank 0 naming what
    each rank loaded and the cut file, nothing written, within 30 s.
+5. SIGTERM in the middle of a macro step that takes minutes (the fluidised
+   bed's vans coupler told to take 10^6 fluid steps per exchange): the
+   step does not end by itself within the 1 s grace, so the coupler, asked
+   through the host (abi.h stop_requested), gives up; exit 143 within
+   2.5 s, the message saying where it stopped, nothing of the step written.
 """
 import json
 import os
@@ -292,6 +297,36 @@ if mpiexec:
               "rank 0 names what differs and the cut file")
         check(r.stderr.count("nothing was run") == 1 and "MPI_ABORT" not in r.stderr, "said once, no abort")
         check(not os.path.exists(os.path.join(folder, "summary.json")), "nothing written")
+
+# 5. a stop request inside a macro step that does not end by itself
+mpi_cli.part("5. a stop inside a long step")
+bed = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(scenario))), "fluid", "bed", "a4.json")
+with open(bed) as f:
+    doc = json.load(f)
+doc["fluid"]["substeps"] = 1000000  # the first exchange alone takes minutes
+doc["run"]["checkpoint_interval"] = 0.01
+slow_scenario = write_scenario(doc, "bed_slow")
+folder = os.path.join(work, "bed_slow")
+proc = subprocess.Popen([domel, "run", slow_scenario, "--out", folder, "--quiet"], env=env,
+                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+started = wait_for(os.path.join(folder, "domel_manifest.txt"))
+time.sleep(1.0)  # set-up done, the first exchange under way
+proc.send_signal(signal.SIGTERM)
+start = time.monotonic()
+try:
+    out, err = proc.communicate(timeout=30)
+    took = time.monotonic() - start
+    print(f"SIGTERM in the middle of a fluid exchange of 10^6 fluid steps: ended {took:.2f} s later, exit "
+          f"{proc.returncode}: {err.strip().splitlines()[-2:]}", flush=True)
+    check(started and proc.returncode == 143, f"exit 143 (found {proc.returncode})")
+    check(took < 1.0 + 1.5, f"ended within the 1 s grace and 1.5 s of work (took {took:.2f} s)")
+    check("interrupted in the middle of a macro step" in err and "vans: stopped on request after" in err and
+          "no checkpoint was written" in err, "the message says where the step stopped: " + err[-500:])
+    check(not os.path.exists(os.path.join(folder, "summary.json")) and not leftovers(folder),
+          "nothing of the unfinished step written")
+except subprocess.TimeoutExpired:
+    proc.kill()
+    check(False, "SIGTERM in the middle of a long fluid exchange: no end within 30 s")
 
 mpi_cli.part(None)
 if failures:

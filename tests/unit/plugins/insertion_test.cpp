@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <random>
 #include <string>
@@ -353,6 +354,38 @@ TEST(RandomInsertion, ImpossibleTargetThrowsWithExplanation) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("does not fit"), std::string::npos) << e.what();
   }
+}
+
+// A host that says stop (abi.h stop_requested, ABI 2.6) ends a long fill with
+// StopRequested saying how far it got (a fill that jams with a billion
+// attempts per particle would otherwise run for minutes inside one step); a
+// host of ABI 2.5, whose struct ends before stop_requested, is never asked.
+TEST(RandomInsertion, AStopRequestEndsALongFillAndAnOlderHostIsNeverAsked) {
+  struct Fake {
+    static int stop(void*) { return 1; }
+  };
+  domel_host_v2 host{};
+  host.struct_size = sizeof host;
+  host.abi_minor = 6;
+  host.stop_requested = &Fake::stop;
+  const double d = 0.001;
+  const json params = {{"diameter", d}, {"count", 500}, {"max_attempts", 1000000000}};
+  const domel_insert_request_v1 jam = box_request(0, 0, 0, 5 * d, 5 * d, 5 * d);
+  try {
+    const RandomFill model{Params(params, domel::sdk::Host(&host))};
+    Inserted out;
+    model.insert(jam, out);
+    FAIL() << "expected StopRequested";
+  } catch (const domel::sdk::StopRequested& e) {
+    EXPECT_NE(std::string(e.what()).find("random: stopped on request after placing "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(" of 500 particles"), std::string::npos) << e.what();
+  }
+  host.struct_size = offsetof(domel_host_v2, stop_requested);  // ABI 2.5's host
+  host.abi_minor = 5;
+  const RandomFill older{Params({{"diameter", d}, {"count", 20}}, domel::sdk::Host(&host))};
+  Inserted out;
+  older.insert(box_request(0, 0, 0, 20 * d, 20 * d, 20 * d), out);
+  EXPECT_EQ(out.x.size(), 20u);
 }
 
 // Guards the exactly-one-of rule for count and volume_fraction and their ranges.

@@ -41,7 +41,7 @@
 #include <stdint.h>
 
 #define DOMEL_ABI_MAJOR 2
-#define DOMEL_ABI_MINOR 5
+#define DOMEL_ABI_MINOR 6
 
 #if defined(_WIN32)
 #define DOMEL_EXPORT __declspec(dllexport)
@@ -95,6 +95,16 @@ typedef struct domel_host_v2 {
    *  callback that then returns a failure status with an empty message
    *  buffer is reported with this text. Thread-safe. */
   void (*error)(void* context, domel_status code, const char* utf8_message);
+  /** ABI 2.6: nonzero once this process was asked to stop (SIGINT, SIGTERM)
+   *  more than a second ago and the macro step in progress has not ended by
+   *  itself (it would end with a checkpoint). A callback that may run for
+   *  long (many insertion attempts, many fluid steps in one exchange) asks
+   *  every so often and, when told to stop, fails (DOMEL_ERR_RUNTIME) with a
+   *  message saying how far it got: the host ends the run as interrupted
+   *  without finishing the step (the last checkpoint stands). Cheap (a clock
+   *  read); thread-safe. Absent (beyond struct_size) in hosts older than 2.6:
+   *  read it as 0. */
+  int (*stop_requested)(void* context);
 } domel_host_v2;
 
 /* ------------------------------------------------------------------------ */

@@ -62,6 +62,14 @@ class ParameterError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Thrown by a model's long loop when Host::stop_requested() says the run is
+/// to stop: the callback fails with the message (how far it got), and the
+/// host ends the run as interrupted.
+class StopRequested : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// The host services of one model instance (abi.h, domel_host_v2). Cheap to
 /// copy; valid while the instance lives. Messages are prefixed by the host
 /// with the model's kind and name, its library and its scenario location.
@@ -80,6 +88,14 @@ class Host {
   }
   void log(int level, const std::string& m) const {
     if (h_ != nullptr && h_->log) h_->log(h_->context, level, m.c_str());
+  }
+  /// True once the run was asked to stop and the step in progress has not
+  /// ended within a second (ABI 2.6; false from an older host): a long loop
+  /// asks every so often and throws StopRequested.
+  bool stop_requested() const {
+    return h_ != nullptr &&
+           h_->struct_size >= offsetof(domel_host_v2, stop_requested) + sizeof(h_->stop_requested) &&
+           h_->stop_requested != nullptr && h_->stop_requested(h_->context) != 0;
   }
   const domel_host_v2* raw() const { return h_; }
 
