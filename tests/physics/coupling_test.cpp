@@ -13,7 +13,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <unistd.h>  // getpid: the 1- and 2-thread variants of a test may run at once
@@ -159,6 +161,61 @@ TEST(Coupling, CountsEachParcelOnceAndInsertsItsFineParticlesInTheShell) {
 // massflow/mesh/face fixes counts once on its own (docs/multilevel.md): a
 // parcel that came in through the top and bounces back up through the bottom
 // (off a bed below the region) is counted by the bottom face too, once.
+// The inflow places no fine particle overlapping a wall, a mesh included (it
+// asks the same WallClearance as insertions and pours, issue 41): a flat STL
+// surface of two triangles, tilted by 0.2 across the inflow shell
+// [0.0188, 0.03] m, cuts it in two. The fine particles of five parcels go
+// where they clear it; the distance to the surface is the plane's, written
+// out here (the triangles cover the region's whole extent). Cost: 0.1 s.
+TEST(Coupling, TheInflowPlacesNothingOverlappingAMeshWall) {
+  json doc = two_level();
+  const std::string stl = (std::filesystem::temp_directory_path() /
+                           ("domel_inflow_mesh_" + std::to_string(getpid()) + ".stl")).string();
+  auto z_of = [](double x) { return 0.024 + 0.2 * (x - 0.03); };  // the surface z(x), flat along y
+  {
+    std::ofstream out(stl);
+    const double x0 = -0.1, x1 = 0.16, y0 = -0.02, y1 = 0.08;  // z from -0.002 to 0.05: it spans the region
+    auto vertex = [&](double x, double y) { out << "      vertex " << x << " " << y << " " << z_of(x) << "\n"; };
+    out << "solid tilted\n";
+    for (int t = 0; t < 2; ++t) {
+      out << "  facet normal 0 0 1\n    outer loop\n";
+      if (t == 0) { vertex(x0, y0); vertex(x1, y0); vertex(x1, y1); }
+      else { vertex(x0, y0); vertex(x1, y1); vertex(x0, y1); }
+      out << "    endloop\n  endfacet\n";
+    }
+    out << "endsolid tilted\n";
+  }
+  doc["walls"] = {{{"name", "tilted"}, {"type", "mesh"}, {"material", "m"}, {"file", stl}}};
+  Levels s = make(doc);
+  std::filesystem::remove(stl);
+  auto& c = s.coarse();
+  const auto moved = above(c, 5);
+  ASSERT_EQ(moved.size(), 5u);
+  for (std::size_t q : moved) {
+    c.z[q] = 0.025;
+    c.vz[q] = -0.5;
+  }
+  s.exchange(1e-3);
+  const dp::FaceBalance& top = s.c->faces()[5];
+  auto& f = s.fine();
+  const double n = std::hypot(0.2, 1.0);  // the surface's normal (-0.2, 0, 1) / n
+  double closest = INFINITY;
+  std::size_t below = 0;
+  for (std::size_t q = 0; q < f.size(); ++q) {
+    const double d = std::fabs(f.z[q] - z_of(f.x[q])) / n;
+    closest = std::min(closest, (d - f.radius[q]) / f.radius[q]);
+    below += f.z[q] < z_of(f.x[q]) ? 1 : 0;
+  }
+  std::printf("[inflow beside a mesh] %zu fine particles placed (%zu under the surface), least clearance %.3g "
+              "radii, %zu waiting\n", f.size(), below, closest, top.queue.size());
+  EXPECT_EQ(top.parcels, 5u);
+  EXPECT_GT(f.size(), 10u);  // the shell has room on both sides of the surface
+  EXPECT_GE(closest, -1e-9);
+  // nothing lost: what is not placed waits in the backlog
+  EXPECT_EQ(top.n_inserted + top.queue.size(), 40u);
+  EXPECT_EQ(top.inserted, fine_mass_units(f));
+}
+
 TEST(Coupling, EachInflowFaceCountsAParcelOnce) {
   json doc = two_level();
   doc["couplings"][0]["inflow_faces"] = {"+z", "-z"};
