@@ -4,6 +4,7 @@
 // stack: scenario -> plugins -> contact pipeline -> integrator.
 #pragma once
 
+#include "core/error.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scenario/scenario.hpp"
 
@@ -75,6 +76,20 @@ inline nlohmann::json lattice_column(double d) {
 
 inline std::unique_ptr<platform::Simulation> build(const nlohmann::json& doc) {
   return platform::load_scenario(doc, "test.json", builtin_registry());
+}
+
+/// The problems load_scenario finds in `doc` (read as if from `file`, which
+/// relative paths are resolved against), one "pointer: message" line each;
+/// empty when it is accepted.
+inline std::string problems(const nlohmann::json& doc, const std::filesystem::path& file = "test.json") {
+  try {
+    platform::load_scenario(doc, file, builtin_registry());
+  } catch (const platform::ConfigError& e) {
+    std::string all;
+    for (const platform::Diagnostic& d : e.diagnostics()) all += d.pointer + ": " + d.message + "\n";
+    return all;
+  }
+  return {};
 }
 
 /// Add a wall to a scenario document (material "m").

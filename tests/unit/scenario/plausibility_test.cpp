@@ -37,16 +37,7 @@ json settle() {
 }
 
 /// The problems validate reports, one "pointer: message" line each.
-std::string problems(const json& doc) {
-  try {
-    dp::load_scenario(doc, kSettle, domel::test::builtin_registry());
-  } catch (const dp::ConfigError& e) {
-    std::string all;
-    for (const dp::Diagnostic& d : e.diagnostics()) all += d.pointer + ": " + d.message + "\n";
-    return all;
-  }
-  return {};
-}
+std::string problems(const json& doc) { return domel::test::problems(doc, kSettle); }
 
 struct Value {
   const char* pointer;  ///< into settle.json

@@ -37,16 +37,7 @@ json read(const fs::path& file) {
 }
 
 /// The problems validate reports for `doc` (read from `file`), as one text.
-std::string problems(const json& doc, const fs::path& file) {
-  try {
-    dp::load_scenario(doc, file, domel::test::builtin_registry());
-  } catch (const dp::ConfigError& e) {
-    std::string all;
-    for (const dp::Diagnostic& d : e.diagnostics()) all += d.pointer + ": " + d.message + "\n";
-    return all;
-  }
-  return {};
-}
+using domel::test::problems;
 
 struct Kind {
   const char* name;
