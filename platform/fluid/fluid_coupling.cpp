@@ -102,6 +102,12 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
   ex.struct_size = sizeof ex;
   ex.time = t;
   ex.interval = spec_.interval;
+  if (spec_.run_macro_steps > 0) {  // the last exchange ends with the run (scenario/build_schedules.cpp)
+    const double macro = spec_.interval / static_cast<double>(spec_.interval_macro);
+    const auto index = static_cast<std::uint64_t>(std::llround(t / macro));
+    if (index < spec_.run_macro_steps && spec_.run_macro_steps - index < spec_.interval_macro)
+      ex.interval = static_cast<double>(spec_.run_macro_steps - index) * macro;
+  }
   ex.level = level_ptrs[0];
   for (int d = 0; d < 3; ++d) ex.gravity[d] = spec_.gravity[d];
   ex.level_count = static_cast<uint32_t>(nl);
@@ -129,6 +135,11 @@ void FluidCoupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& 
       has_limits_ = true;
       last_limits_ = lim;
       last_limit_ = lim.limit ? lim.limit : "";
+      if (lim.has_books) {
+        has_books_ = true;
+        max_momentum_residual_ = std::max(max_momentum_residual_, lim.momentum_residual);
+        for (int d = 0; d < 3; ++d) wall_shear_[d] = lim.wall_shear[d];
+      }
     }
   } catch (const PluginError& e) {
     std::ostringstream os;
@@ -296,6 +307,10 @@ nlohmann::json FluidCoupling::summary() const {
                    {"limit", last_limit_},
                    {"solver_iterations", last_limits_.solver_iterations},
                    {"solver_residual", last_limits_.solver_residual}};
+  if (has_books_) {
+    j["momentum_residual"] = max_momentum_residual_;
+    j["wall_shear_N"] = {wall_shear_[0], wall_shear_[1], wall_shear_[2]};
+  }
   if (fields_out_) j["fields"] = "fluid.pvd";
   return j;
 }

@@ -50,6 +50,9 @@ struct FluidSpec {
   std::uint64_t interval_macro = 1;      ///< exchange every this many macro steps
   double interval = 0;                   ///< = interval_macro x the macro step [s]
   double write_interval = 0;             ///< fields output interval [s]; 0: none
+  /// The scenario's run in macro steps (run.duration; 0: not known): the
+  /// exchange that would carry the fluid past it covers only what is left.
+  std::uint64_t run_macro_steps = 0;
   double gravity[3] = {0, 0, 0};         ///< [m/s^2]
   /// The plugin was built for ABI 2.1, which knows one level per exchange
   /// and no linearised drag: it is called once per level.
@@ -127,6 +130,12 @@ class FluidCoupling final : public Component {
   bool has_limits_ = false;
   domel_fluid_limits_v1 last_limits_{};
   std::string last_limit_;  ///< last_limits_.limit's text
+  /// The coupler's momentum books (ABI 2.6, domel_fluid_limits_v1.has_books):
+  /// the largest residual of the exchanges since the run (or its restart)
+  /// began, and the no-slip walls' force on the fluid at the last exchange.
+  bool has_books_ = false;
+  double max_momentum_residual_ = 0;
+  std::array<double, 3> wall_shear_{0, 0, 0};
   std::vector<std::array<double, 3>> net_force_;  ///< per level, at the last exchange [N]
   std::unique_ptr<io::FieldImageSeries> fields_out_;
 };

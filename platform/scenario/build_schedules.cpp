@@ -13,6 +13,10 @@
 #include "loop/macro_step.hpp"
 
 #include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -70,6 +74,34 @@ std::vector<Schedule> given_schedules(const json& d) {
   return list;
 }
 
+/// The fluid's coupling interval against the run: an exchange advances the
+/// fluid over an interval, so one longer than the run is refused (issue 45:
+/// 0.05 s in a 0.02 s run advanced the fluid past the run's end); where the
+/// run is not a whole number of intervals, the last exchange covers what is
+/// left (FluidSpec::run_macro_steps), said once.
+void check_fluid_interval(Build& b, double macro) {
+  const json* fluid = member(b.doc, "fluid");
+  const json* v = fluid ? member(*fluid, "interval") : nullptr;
+  if (!v || !v->is_number() || !(v->get<double>() > 0) || !(b.sim.duration > 0)) return;
+  // as build_fluid rounds it: whole macro steps
+  const auto every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(v->get<double>() / macro)));
+  const auto total = static_cast<std::uint64_t>(std::ceil(b.sim.duration / macro - kTimeTolerance));
+  if (total == 0) return;
+  const double interval = static_cast<double>(every) * macro;
+  if (every > total) {
+    b.ck.add("/fluid/interval",
+             "expected a coupling interval of at most the run's duration, " + seconds(b.sim.duration) +
+                 " s (an exchange advances the fluid over a whole interval: it would carry it past the run's end), "
+                 "found " + seconds(interval) + " s",
+             "give " + seconds(b.sim.duration) + " s or less");
+    return;
+  }
+  if (total % every == 0) return;
+  spdlog::info("/fluid/interval: the run's {} s is {:.6g} coupling intervals of {} s: the last exchange advances the "
+               "fluid {} s, to the run's end", seconds(b.sim.duration), static_cast<double>(total) / every,
+               seconds(interval), seconds(static_cast<double>(total % every) * macro));
+}
+
 }  // namespace
 
 void check_schedules(Build& b) {
@@ -86,6 +118,8 @@ void check_schedules(Build& b) {
       spdlog::warn("{}: {} s makes {:.3g} {} in a run of {} s (more than {:.0e}); was a larger interval meant?",
                    s.pointer, seconds(s.interval), count, s.what, seconds(b.sim.duration), kManyActions);
   }
+  check_fluid_interval(b, macro);
 }
+
 
 }  // namespace domel::platform::scenario_detail

@@ -10,6 +10,8 @@
 // Diagnostic; build() throws them all at once, before anything is written.
 #include "scenario/build.hpp"
 
+#include "core/cadence.hpp"
+
 #include "core/error.hpp"
 
 namespace domel::platform::scenario_detail {
@@ -48,6 +50,7 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_outputs(b);
   if (fluid) {
     if (fluid->write_interval < 0) fluid->write_interval = b.out.vtk_interval;
+    fluid->run_macro_steps = static_cast<std::uint64_t>(std::ceil(sim->duration / sim->macro_step() - kTimeTolerance));
     sim->fluid = std::make_unique<FluidCoupling>(std::move(*fluid), sim->subdomains);
   }
   register_components(b);

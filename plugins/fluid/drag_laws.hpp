@@ -240,6 +240,7 @@ inline double beta_parcel(DragLaw law, double d_parcel, double alpha, bool scali
 struct Validity {
   bool ok;
   std::string regime;
+  bool no_slip = false;  ///< set by the caller: the particle moves with the fluid (no drag to be wrong about)
 };
 
 // Ranges (Re = eps rho_f d U / mu as in beta(); for Schiller-Naumann the

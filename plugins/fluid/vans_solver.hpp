@@ -167,6 +167,7 @@ class VansSolver {
   const std::vector<double>& pressure() const { return p_; }
   const std::vector<double>& u(int a) const { return u_[a]; }
   const std::vector<double>& K(int a) const { return K_[a]; }
+  const std::vector<double>& Ku(int a) const { return Ku_[a]; }
   const std::vector<FaceKind>& kind(int a) const { return kind_[a]; }
   const std::vector<std::uint8_t>& blocked() const { return blocked_; }
   std::vector<double>& eps_mut() { return eps_; }
@@ -409,6 +410,42 @@ class VansSolver {
     for (int k = 0; k < g.fn(a, 2); ++k)
       for (int j = 0; j < g.fn(a, 1); ++j)
         for (int i = 0; i < g.fn(a, 0); ++i) fn(i, j, k, g.face(a, i, j, k));
+  }
+
+  /// The value of face f of axis a, which the step does not solve for (a
+  /// wall's or an inlet's), at the end of the interval under way: 0 on a wall;
+  /// on an inlet U / eps with the interval's end void fraction (the step sets
+  /// eps u = U there).
+  double fixed_value(int a, std::size_t f) const {
+    if (kind_[a][f] != FaceKind::inlet) return 0.0;
+    const MacGrid& g = s_.grid;
+    const std::size_t n0 = static_cast<std::size_t>(g.fn(a, 0)), n1 = static_cast<std::size_t>(g.fn(a, 1));
+    const int i = static_cast<int>(f % n0), j = static_cast<int>((f / n0) % n1), k = static_cast<int>(f / (n0 * n1));
+    return inlet_value_[a][f] / face_eps(eps_, a, i, j, k);
+  }
+
+  /// The force of the box's no-slip side walls on the fluid [N]: for each
+  /// face next to such a wall and tangential to it, the viscous term the
+  /// step applies there towards the wall, mu eps (u_ghost - u) / h^2 over the
+  /// face's control volume, with the wall's ghost u_ghost = -u.
+  std::array<double, 3> wall_shear() const {
+    const MacGrid& g = s_.grid;
+    std::array<double, 3> F{0, 0, 0};
+    const double V = g.cell_volume();
+    for (int a = 0; a < 3; ++a)
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        const FaceKind kd = kind_[a][f];
+        if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
+        const int idx[3] = {i, j, k};
+        for (int b = 0; b < 3; ++b) {
+          if (b == a) continue;
+          for (int side = 0; side < 2; ++side) {
+            if (idx[b] != (side ? g.fn(a, b) - 1 : 0) || s_.sides[2 * b + side].type != Boundary::wall) continue;
+            F[a] += s_.mu * face_eps(eps_, a, i, j, k) * (-2.0 * u_[a][f]) / (g.h[b] * g.h[b]) * V;
+          }
+        }
+      });
+    return F;
   }
 
   /// Face (i, j, k) of axis a lies inside an obstacle: the cells on both of

@@ -265,11 +265,14 @@ TEST(Vans, AnObstacleIsANoSlipWallOnItsFaceLikeASideOfTheBox) {
           << "column " << i << ", face " << k;
 }
 
-// The gas velocity a particle feels near a no-slip wall vanishes on the wall
-// and grows linearly to the first cell centre (the mirrored ghost): at a
-// quarter cell from the wall it is half the first node's value, for a side
-// of the box and for an obstacle's face alike.
-TEST(Vans, TheGasVelocityAtAParticleVanishesOnANoSlipWall) {
+// The gas velocity a particle feels beside an obstacle's face vanishes on the
+// face and grows linearly to the first cell centre (the mirrored ghost): at
+// a quarter cell from it, half the first node's value. Beside a no-slip side
+// of the box it is the first node's (the gas in the wall's cell: the
+// unresolved model does not resolve a boundary layer within a cell; with
+// the mirror there, a fixed bed 20 diameters wide carried up to 22 % less
+// than Ergun's drop, plugins/fluid/vans.hpp gas_form).
+TEST(Vans, TheGasVelocityAtAParticleVanishesOnAnObstacleAndIsTheCellsBesideABoxWall) {
   for (bool obstacle : {false, true}) {
     Vans v{domel::sdk::Params(channel(obstacle))};
     Particles ps(3);
@@ -280,8 +283,9 @@ TEST(Vans, TheGasVelocityAtAParticleVanishesOnANoSlipWall) {
     const auto& g = v.solver().grid();
     const double u1 = v.solver().u(2)[g.face(2, obstacle ? 1 : 0, 0, 10)];
     ASSERT_GT(u1, 0.01);
-    EXPECT_NEAR(ps.uz[0], 0.5 * u1, 1e-12) << (obstacle ? "obstacle" : "side");
-    EXPECT_NEAR(ps.uz[1], u1, 1e-12) << (obstacle ? "obstacle" : "side");
-    EXPECT_NEAR(ps.uz[2], 2e-6 * u1, 1e-12) << (obstacle ? "obstacle" : "side");  // 1e-9 m from the wall: 2e-9/h of u1
+    const char* where = obstacle ? "obstacle" : "side";
+    EXPECT_NEAR(ps.uz[0], obstacle ? 0.5 * u1 : u1, 1e-12) << where;
+    EXPECT_NEAR(ps.uz[1], u1, 1e-12) << where;
+    EXPECT_NEAR(ps.uz[2], obstacle ? 2e-6 * u1 : u1, 1e-12) << where;  // 1e-9 m from it: 2e-9/h of u1
   }
 }

@@ -499,6 +499,14 @@ typedef struct domel_fluid_limits_v1 {
   double max_interval;        /**< [out] longest stable coupling interval at the current state  [s]; 0: no limit */
   const char* limit;          /**< [out] which limit that is, e.g. "advective CFL |u| dt/dx <= 0.5" (static text) */
   double solver_residual;     /**< [out] relative residual of the last solve (0: none)  [-] */
+  /* ABI 2.6: the last exchange's momentum books (a coupler fills them only
+   * when struct_size reaches them) */
+  uint32_t has_books;         /**< [out] 1: the two below are filled */
+  double momentum_residual;   /**< [out] the force put on the fluid plus the drag given to the particles, against
+                                   the sum of the drags' magnitudes, per axis (the largest), at the exchange's end
+                                   state: 0 but for round-off when the exchange conserves momentum  [-] */
+  double wall_shear[3];       /**< [out] the force of the no-slip walls on the fluid at the end of the exchange
+                                   (the rest of the pressure drop besides the particles' drag)  [N] */
 } domel_fluid_limits_v1;
 
 typedef domel_status (*domel_fluid_fields_fn)(void* instance, domel_fluid_fields_v1* out, char* err,
