@@ -240,7 +240,7 @@ inline double beta_parcel(DragLaw law, double d_parcel, double alpha, bool scali
 struct Validity {
   bool ok;
   std::string regime;
-  bool no_slip = false;  ///< set by the caller: the particle moves with the fluid (no drag to be wrong about)
+  double drag = 0;  ///< set by the caller: the drag force the law gives there [N]
 };
 
 // Ranges (Re = eps rho_f d U / mu as in beta(); for Schiller-Naumann the

@@ -294,6 +294,8 @@ class Vans {
     }
     beta_.resize(ex.level_count);
     to_walls_ = {0, 0, 0};
+    const double g_norm = std::sqrt(ex.gravity[0] * ex.gravity[0] + ex.gravity[1] * ex.gravity[1] +
+                                    ex.gravity[2] * ex.gravity[2]);
     std::size_t invalid = 0;
     std::string regime;
     if (two_way_) {
@@ -308,7 +310,7 @@ class Vans {
           Validity val{true, ""};
           const double b = particle_beta(x, v, p.radius[k], alpha, nullptr, &val);
           beta_[L][k] = b;
-          count_validity(val, invalid, regime);
+          count_validity(val, p.mass[k] * g_norm, invalid, regime);
           for (int a = 0; a < 3; ++a) {
             const GasForm F = gas_form(a, x);
             double fixed = F.constant;
@@ -374,7 +376,7 @@ class Vans {
         } else {
           Validity val{true, ""};
           drag.beta[k] = particle_beta(x, v, p.radius[k], alpha, uf, &val);
-          count_validity(val, invalid, regime);
+          count_validity(val, p.mass[k] * g_norm, invalid, regime);
         }
         drag.ux[k] = uf[0], drag.uy[k] = uf[1], drag.uz[k] = uf[2];
         if (pressure_force_) {
@@ -542,11 +544,12 @@ class Vans {
  private:
   static double volume(double r) { return 4.0 / 3.0 * M_PI * r * r * r; }
 
-  /// Counts a particle outside its drag law's fitted range, but not one with
-  /// no slip at all (a particle at rest in gas at rest feels no drag, whatever
-  /// the law says at Re = 0).
-  static void count_validity(const Validity& val, std::size_t& invalid, std::string& regime) {
-    if (val.ok || val.no_slip) return;
+  /// Counts a particle outside its drag law's fitted range, but not one whose
+  /// drag is below 0.1 % of its weight (with no gravity: no drag at all): a
+  /// sphere released at rest in still gas feels none, whatever the law says
+  /// at its Re near 0, and the law's error cannot matter there.
+  static void count_validity(const Validity& val, double weight, std::size_t& invalid, std::string& regime) {
+    if (val.ok || val.drag <= 1e-3 * weight) return;
     ++invalid;
     if (regime.empty()) regime = val.regime;
   }
@@ -696,9 +699,10 @@ class Vans {
     if (val) {
       const double d = scaling_ ? 2 * r / alpha : 2 * r;
       *val = validity(law_, e, reynolds(law_ == DragLaw::schiller_naumann ? 1.0 : e, s.rho, d, slip, s.mu));
-      val->no_slip = slip == 0.0;
     }
-    return beta_parcel(law_, 2 * r, alpha, scaling_, e, slip, s.rho, s.mu);
+    const double beta = beta_parcel(law_, 2 * r, alpha, scaling_, e, slip, s.rho, s.mu);
+    if (val) val->drag = beta * slip;
+    return beta;
   }
 
   static std::vector<std::uint8_t> block_cells(const MacGrid& g, const nlohmann::json& obstacles) {

@@ -15,6 +15,7 @@
 //      100, to the pressure solve's tolerance (the issue asks 5 %); with the
 //      Gidaspow law that value is Ergun's (1952) pressure drop.
 #include "plugins/fluid/drag_laws.hpp"
+#include "abi/log_capture.hpp"
 #include "support/fixture.hpp"
 
 #include <gtest/gtest.h>
@@ -247,6 +248,29 @@ double law_gradient(fl::DragLaw law, double us, double eps, double d) {
 }
 
 }  // namespace
+
+// A sphere released at rest in still air feels no drag at first: no warning
+// that its Re (0) lies below the Di Felice law's fitted range; once it falls
+// (a 10 um sphere settles at Re about 5e-3) the warning comes, at the second
+// exchange. Cost: 0.1 s.
+TEST(FluidVans, NoDragLawWarningForASphereAtRestButOneOnceItFallsBelowTheRange) {
+  for (double d : {1e-3, 1e-5}) {
+    json doc = settling(d, 1.0, true, 0.002, 5e-6, 1.0);
+    doc["fluid"]["drag"]["law"] = "di_felice";
+    doc["fluid"]["interval"] = 1e-4;
+    auto sim = dt::build(doc);
+    domel::test::LogCapture log;
+    run(*sim, "at_rest");
+    const std::string text = log.text.str();
+    const std::size_t at = text.find("Re <= 1e-2");
+    if (d > 1e-4) {
+      EXPECT_EQ(at, std::string::npos) << text;
+    } else {
+      ASSERT_NE(at, std::string::npos) << text;
+      EXPECT_NE(text.find("at t = 0.000100 s"), std::string::npos) << text;
+    }
+  }
+}
 
 // (b) Re_p = rho_f us d / mu = 1, 20 and 100.
 TEST(FluidVans, FixedBedPressureGradientFollowsTheDragLaw) {
