@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace domel::platform {
 
@@ -16,7 +17,13 @@ double macro_step_of(const std::vector<std::unique_ptr<Subdomain>>& subdomains) 
 }
 
 int substeps_of(double macro, double dt) {
-  return std::max(1, static_cast<int>(std::ceil(macro / dt - kTimeTolerance)));
+  // bounded before the conversion: levels whose steps differ by more than an
+  // int counts (1000 s against 2e-7 s; the run-time fuzzer gave levels such
+  // steps) get the most one holds
+  const double n = std::ceil(macro / dt - kTimeTolerance);
+  if (!(n >= 1.0)) return 1;  // NaN too
+  if (n >= static_cast<double>(std::numeric_limits<int>::max())) return std::numeric_limits<int>::max();
+  return static_cast<int>(n);
 }
 
 }  // namespace domel::platform

@@ -442,7 +442,7 @@ void build_couplings(Build& b) {
   std::uint64_t control_macro = std::numeric_limits<std::uint64_t>::max();
   for (std::size_t c = 0; c < specs.size(); ++c) {
     const int n_f = substeps_of(macro, sim.subdomains[specs[c].fine]->time_step());
-    control_macro = std::min<std::uint64_t>(control_macro, (requested[c] + n_f - 1) / n_f);
+    control_macro = std::min<std::uint64_t>(control_macro, (static_cast<std::uint64_t>(requested[c]) + n_f - 1) / n_f);
   }
   sim.control_macro = control_macro;
   for (std::size_t c = 0; c < specs.size(); ++c) {
@@ -452,6 +452,19 @@ void build_couplings(Build& b) {
     const int n_f = substeps_of(macro, sim.subdomains[s.fine]->time_step());
     const int n_c = substeps_of(macro, sim.subdomains[s.coarse]->time_step());
     s.control_macro = control_macro;
+    // the steps of a control interval are counted in an int: levels whose
+    // time steps differ by 5e8 (an empty fine level given 1000 s, the coarse
+    // one 2e-6 s: the run-time fuzzer) overflowed it
+    const double most = static_cast<double>(std::max(n_f, n_c)) * static_cast<double>(control_macro);
+    if (!(most <= static_cast<double>(std::numeric_limits<int>::max()))) {
+      b.ck.add(base, "the control interval of " + std::to_string(control_macro) + " macro step(s) of " + fmt_num(macro) +
+                         " s is " + fmt_num(most) + " steps of the level with the shorter time step (" +
+                         fmt_num(macro / std::max(n_f, n_c)) + " s), more than a control interval can count (" +
+                         std::to_string(std::numeric_limits<int>::max()) + ")",
+                 "check the levels' time steps: the macro step is the largest of them (" +
+                     sim.subdomains[n_f >= n_c ? s.coarse : s.fine]->name() + "'s)");
+      continue;
+    }
     s.fine_steps = static_cast<int>(control_macro) * n_f;
     s.coarse_steps = static_cast<int>(control_macro) * n_c;
     if (s.fine_steps != requested[c])

@@ -107,10 +107,23 @@ void build_repose_probe(Build& b) {
   b.sim.repose_probe = rp;
 }
 
+/// The most macro steps a run may have: run.steps' schema maximum.
+constexpr double kMaxMacroSteps = 1e15;
+
 void build_duration(Build& b) {
   const json& run = b.doc["run"];
   if (run.contains("duration")) {
     b.sim.duration = run["duration"].get<double>();
+    // the run counts its macro steps in 64 bits; run.steps' own limit holds
+    // for a duration too (1e300 s made a count beyond any integer: the
+    // run-time fuzzer)
+    const double macro = b.sim.macro_step();
+    if (macro > 0 && std::isfinite(macro) && !(b.sim.duration / macro <= kMaxMacroSteps))
+      b.ck.add("/run/duration",
+               "a run of " + fmt_num(b.sim.duration) + " s is " + fmt_num(b.sim.duration / macro) +
+                   " macro steps of " + fmt_num(macro) + " s, more than the " + fmt_num(kMaxMacroSteps) +
+                   " a run can count",
+               "check the duration's units (run.steps accepts at most 1e15 too)");
   } else {
     b.sim.duration = static_cast<double>(run["steps"].get<std::uint64_t>()) * b.sim.macro_step();
   }

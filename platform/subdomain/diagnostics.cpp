@@ -79,16 +79,23 @@ InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit, cons
   InitialOverlaps out;
   const std::size_t n = s.size();
   if (n < 2) return out;
-  double rmax = 0, lo[3] = {s.x[0], s.y[0], s.z[0]};
+  double rmax = 0, lo[3] = {s.x[0], s.y[0], s.z[0]}, hi[3] = {s.x[0], s.y[0], s.z[0]};
   for (std::size_t k = 0; k < n; ++k) {
     rmax = std::max(rmax, s.radius[k]);
     lo[0] = std::min(lo[0], s.x[k]);
     lo[1] = std::min(lo[1], s.y[k]);
     lo[2] = std::min(lo[2], s.z[k]);
+    hi[0] = std::max(hi[0], s.x[k]);
+    hi[1] = std::max(hi[1], s.y[k]);
+    hi[2] = std::max(hi[2], s.z[k]);
   }
   if (!(rmax > 0) || !std::isfinite(lo[0] + lo[1] + lo[2])) return out;
-  // hash the cells (x, y, z) -> particles: a sparse pour or a tall silo needs no dense grid
-  const double cell = 2.0 * rmax;
+  // hash the cells (x, y, z) -> particles: a sparse pour or a tall silo needs no dense grid.
+  // A cell is at least the largest diameter (a particle's partners lie in the 27 cells
+  // around its own) and at least a 1e-9th of the particles' extent, so that radii of
+  // 1e-300 m give cell indices of at most 1e9, not infinite ones (run-time fuzzer).
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  const double cell = std::max(2.0 * rmax, std::isfinite(extent) ? 1e-9 * extent : 0.0);
   using Cell = std::array<long long, 3>;
   struct CellHash {
     std::size_t operator()(const Cell& c) const {
@@ -98,7 +105,12 @@ InitialOverlaps find_initial_overlaps(const ParticleStore& s, double limit, cons
     }
   };
   auto key = [](long long i, long long j, long long k) { return Cell{i, j, k}; };
-  auto coord = [&](double v, int a) { return static_cast<long long>(std::floor((v - lo[a]) / cell)); };
+  auto coord = [&](double v, int a) {
+    // clamped (monotonically, so neighbouring cells stay neighbours) to what a long long holds;
+    // NaN (an extent beyond a double) goes to the last cell
+    const double t = std::floor((v - lo[a]) / cell);
+    return static_cast<long long>(t < -1e15 ? -1e15 : t < 1e15 ? t : 1e15);
+  };
   std::unordered_map<Cell, std::vector<std::uint32_t>, CellHash> cells;
   cells.reserve(n);
   for (std::size_t k = 0; k < n; ++k)

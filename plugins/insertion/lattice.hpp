@@ -120,10 +120,27 @@ class Lattice {
         base[k] = origin_[k];
         const double i0 = std::ceil((b.lo[k] - base[k]) / a - 0.5 - 1e-9);
         const double i1 = std::floor((b.hi[k] - base[k]) / a - 0.5 + 1e-9);
+        // a site index must be an integer the loop can count to (a tiny
+        // diameter or a far origin gives an infinite or huge one)
+        if (!(std::fabs(i0) <= 1e15) || !(std::fabs(i1) <= 1e15)) {
+          std::ostringstream m;
+          m << "lattice: the region lies more than 1e15 lattice spacings of " << a << " m from 'origin' ("
+            << origin_[k] << " m along " << "xyz"[k] << "); check the diameter's units or the origin";
+          throw std::runtime_error(m.str());
+        }
         f = i1 - i0 + 1.0;
         first[k] = static_cast<long long>(i0);
       } else {
         f = std::floor((b.hi[k] - b.lo[k]) / a + 1e-9);
+      }
+      // the sites are visited one by one, those outside the region too: rows
+      // of 1e10 (a diameter of 1e-12 m, or 5e-324: the run-time fuzzer) took
+      // a minute, or for ever, even with a count a few of them would reach
+      if (!(f <= kMaxSitesAlong)) {
+        std::ostringstream m;
+        m << "lattice: the region spans " << f << " lattice spacings of " << a << " m along " << "xyz"[k]
+          << ", more than " << kMaxSitesAlong << "; check the diameter's units";
+        throw std::runtime_error(m.str());
       }
       sites *= std::max(f, 0.0);
       n[k] = f > 0.0 ? static_cast<long long>(std::min(f, 1e15)) : 0;
@@ -183,6 +200,7 @@ class Lattice {
 
  private:
   static constexpr double kMaxSites = 2e8;
+  static constexpr double kMaxSitesAlong = 1e7;  ///< lattice sites along one axis of the region's box
 
   /// A distribution's largest diameter, which spaces the lattice.
   double largest(const sdk::Params& p) {

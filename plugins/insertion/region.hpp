@@ -137,14 +137,18 @@ class SphereGrid {
     h_ = std::max(min_cell, std::cbrt(volume / static_cast<double>(cell_budget)));
     if (!(h_ > 0.0)) h_ = 1.0;
     for (;;) {
-      double cells = 1.0;
+      double n[3], cells = 1.0;
       for (int k = 0; k < 3; ++k) {
-        const double n = std::max(1.0, std::ceil((box_.hi[k] - box_.lo[k]) / h_));
-        n_[k] = static_cast<long long>(n);
-        cells *= n;
+        n[k] = std::max(1.0, std::ceil((box_.hi[k] - box_.lo[k]) / h_));  // NaN (an infinite extent): 1
+        cells *= n[k];
       }
-      if (cells <= 2.0 * static_cast<double>(cell_budget) + 8.0) break;
-      h_ *= 1.25;  // thin boxes: ceil() on each axis inflated the count
+      if (cells <= 2.0 * static_cast<double>(cell_budget) + 8.0) {
+        for (int k = 0; k < 3; ++k) n_[k] = static_cast<long long>(n[k]);  // counted first: no overflow
+        break;
+      }
+      // thin boxes: ceil() on each axis inflated the count; a box far longer
+      // than wide (1e300 m by 1 cm: the run-time fuzzer) needs far larger cells
+      h_ *= std::max(1.25, std::cbrt(cells / (2.0 * static_cast<double>(cell_budget))));
     }
     head_.assign(static_cast<std::size_t>(n_[0] * n_[1] * n_[2]), kNone);
   }

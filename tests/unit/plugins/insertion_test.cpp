@@ -271,6 +271,22 @@ TEST(RandomInsertion, ReachesCountWithoutOverlapInBox) {
   for (double r : out.r) EXPECT_DOUBLE_EQ(r, d / 2);
 }
 
+// Guards the RSA grid of a box far longer than wide (1e300 m by 1 cm, found by the run-time
+// fuzzer, docs/reliability.md): its cell counts were converted to integers before they were
+// bounded (2.4e202 cells along y; undefined behaviour, reported by UBSan); now the cells grow
+// until the count fits, and the fill places its particles as in any other box.
+TEST(RandomInsertion, ABoxFarLongerThanWideIsFilled) {
+  const auto q = box_request(0.001, -0.005, 0.001, 0.011, 1e300, 0.008, 5);
+  const auto out = run<RandomFill>({{"diameter", 0.0015}, {"diameter_max", 0.0025}, {"count", 30}}, q);
+  ASSERT_EQ(out.size(), 30u);
+  EXPECT_EQ(overlapping_pairs(out), 0u);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    EXPECT_GE(out.x[i] - out.r[i], 0.001 - 1e-12);
+    EXPECT_LE(out.x[i] + out.r[i], 0.011 + 1e-12);
+    EXPECT_GE(out.y[i], -0.005);
+  }
+}
+
 // Guards RSA in a cylinder (axis y, off-axis lo/hi junk): count reached, inside, no overlap.
 TEST(RandomInsertion, ReachesCountWithoutOverlapInCylinder) {
   const double d = 0.002;
