@@ -271,14 +271,27 @@ void TriangleGrid::build(const std::vector<double>& verts, const TriangleMesh& m
       lo[a] = std::min(lo[a], verts[v + a] - reach);
       hi[a] = std::max(hi[a], verts[v + a] + reach);
     }
-  // Cells at least 2 reach wide, and at most ~2M of them.
+  // Cells at least 2 reach wide, and at most ~2M of them. A flat mesh has
+  // little volume: its cells grow until their count fits too (a reach of
+  // 1e-12 m across a 10 cm chute asked for 10^11 cells), counted as doubles
+  // before they are converted.
   double cell = 2.0 * reach;
   const double vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
   cell = std::max(cell, std::cbrt(vol / 2.0e6));
-  inv_cell_ = 1.0 / cell;
+  double n[3];
+  for (;;) {
+    inv_cell_ = 1.0 / cell;
+    double count = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      n[a] = std::max(1.0, std::ceil((hi[a] - lo[a]) * inv_cell_));  // NaN (an infinite extent): 1
+      count *= n[a];
+    }
+    if (count <= 4.0e6) break;
+    cell *= std::max(1.25, std::cbrt(count / 2.0e6));
+  }
   for (int a = 0; a < 3; ++a) {
     lo_[a] = lo[a];
-    dims_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a]) * inv_cell_)));
+    dims_[a] = static_cast<int>(n[a]);
   }
   const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
   std::vector<std::pair<uint32_t, uint32_t>> pairs;  // (cell, triangle)

@@ -83,12 +83,14 @@ void check_fluid_interval(Build& b, double macro) {
   const json* fluid = member(b.doc, "fluid");
   const json* v = fluid ? member(*fluid, "interval") : nullptr;
   if (!v || !v->is_number() || !(v->get<double>() > 0) || !(b.sim.duration > 0)) return;
-  // as build_fluid rounds it: whole macro steps
-  const auto every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(v->get<double>() / macro)));
-  const auto total = static_cast<std::uint64_t>(std::ceil(b.sim.duration / macro - kTimeTolerance));
-  if (total == 0) return;
-  const double interval = static_cast<double>(every) * macro;
-  if (every > total) {
+  // as build_fluid rounds it: whole macro steps; counted as doubles first, so
+  // that a duration of 1e300 s (refused by build_duration: more macro steps
+  // than a run counts; the run-time fuzzer) converts no huge count
+  const double n_every = std::max(1.0, std::round(v->get<double>() / macro));
+  const double n_total = std::ceil(b.sim.duration / macro - kTimeTolerance);
+  if (!(n_total >= 1.0) || !(n_total <= 1e15)) return;
+  const double interval = n_every * macro;
+  if (n_every > n_total) {
     b.ck.add("/fluid/interval",
              "expected a coupling interval of at most the run's duration, " + seconds(b.sim.duration) +
                  " s (an exchange advances the fluid over a whole interval: it would carry it past the run's end), "
@@ -96,6 +98,7 @@ void check_fluid_interval(Build& b, double macro) {
              "give " + seconds(b.sim.duration) + " s or less");
     return;
   }
+  const auto every = static_cast<std::uint64_t>(n_every), total = static_cast<std::uint64_t>(n_total);
   if (total % every == 0) return;
   spdlog::info("/fluid/interval: the run's {} s is {:.6g} coupling intervals of {} s: the last exchange advances the "
                "fluid {} s, to the run's end", seconds(b.sim.duration), static_cast<double>(total) / every,

@@ -333,8 +333,9 @@ class Vans {
     }
     // 3. the fluid over the interval
     if (auto_substeps_) {
-      const double need = ex.interval * std::max(advective_rate() / cfl_, viscous_rate());
-      substeps_ = std::clamp(static_cast<int>(std::ceil(need * (1.0 - 1e-12))), 1, max_substeps_);
+      const double need = std::ceil(ex.interval * std::max(advective_rate() / cfl_, viscous_rate()) * (1.0 - 1e-12));
+      // clamped before the conversion (a gas at 1e300 m/s needs more steps than an int holds; NaN: 1)
+      substeps_ = !(need > 1.0) ? 1 : need >= max_substeps_ ? max_substeps_ : static_cast<int>(need);
       if (substeps_ > substeps_used_max_) {
         substeps_used_max_ = substeps_;
         host_.info("substeps auto: " + std::to_string(substeps_) + " fluid steps per coupling interval from exchange " +
