@@ -379,29 +379,24 @@ int cmd_run(int argc, char** argv) {
     }
   } catch (const std::exception& e) {
     const std::string where = world().size() > 1 ? " on rank " + std::to_string(world().rank()) : "";
+    // what the run can go on from
+    const auto& ck = sim->last_checkpoint();
+    const std::string resume = ck ? "the last checkpoint, of t = " + fmt::format("{:.6g}", ck->time) +
+                                        " s, is intact; continue with: domel run " + a.positional[0] + " --restart " +
+                                        ck->file.string()
+                                  : std::string("no checkpoint was written");
     if (const int sig = dp::interrupt_requested(); sig != 0 && dp::stop_overdue()) {
       // a loop inside the step gave up on the stop request (core/interrupt.hpp), or failed while it waited
-      std::string then = "nothing of the unfinished step was written";
-      if (const auto& ck = sim->last_checkpoint())
-        then += "; the last checkpoint, of t = " + fmt::format("{:.6g}", ck->time) +
-                " s, is intact; continue with: domel run " + a.positional[0] + " --restart " + ck->file.string();
-      else
-        then += "; no checkpoint was written";
       std::fprintf(stderr, "domel: interrupted%s in the middle of a macro step that did not end within %.0f s of "
-                           "the request: %s\n%s; summary.json was not written\n",
-                   where.c_str(), dp::kStopGraceSeconds, e.what(), then.c_str());
+                           "the request: %s\nnothing of the unfinished step was written; %s; summary.json was not "
+                           "written\n",
+                   where.c_str(), dp::kStopGraceSeconds, e.what(), resume.c_str());
       g_stopped_mid_step = true;
       return 128 + sig;
     }
-    std::string then;
-    if (const auto& ck = sim->last_checkpoint())
-      then = "the last checkpoint, of t = " + fmt::format("{:.6g}", ck->time) + " s, is intact; continue with: domel run " +
-             a.positional[0] + " --restart " + ck->file.string();
-    else
-      then = "no checkpoint was written (run.checkpoint_interval)";
     std::fprintf(stderr, "domel: the run of %s failed%s: %s\nFiles written before the failure are complete; "
-                         "summary.json was not written; %s\n", a.positional[0].c_str(), where.c_str(), e.what(),
-                 then.c_str());
+                         "summary.json was not written; %s%s\n", a.positional[0].c_str(), where.c_str(), e.what(),
+                 resume.c_str(), ck ? "" : " (run.checkpoint_interval)");
     return kExitRunFailed;
   }
   return 0;

@@ -307,12 +307,15 @@ class Vans {
         for (std::size_t k = 0; k < p.n; ++k) {
           const double x[3] = {p.x[k], p.y[k], p.z[k]};
           const double v[3] = {vm ? vm[3 * k] : p.vx[k], vm ? vm[3 * k + 1] : p.vy[k], vm ? vm[3 * k + 2] : p.vz[k]};
+          GasForm forms[3];
+          double u[3];
+          for (int a = 0; a < 3; ++a) forms[a] = gas_form(a, x), u[a] = value(forms[a], a);
           Validity val{true, ""};
-          const double b = particle_beta(x, v, p.radius[k], alpha, nullptr, &val);
+          const double b = beta_at(x, u, v, p.radius[k], alpha, &val);
           beta_[L][k] = b;
           count_validity(val, p.mass[k] * g_norm, invalid, regime);
           for (int a = 0; a < 3; ++a) {
-            const GasForm F = gas_form(a, x);
+            const GasForm& F = forms[a];
             double fixed = F.constant;
             for (int q = 0; q < F.n; ++q) {
               if (takes_part(a, F.face[q])) f.K_mut(a)[F.face[q]] += b * F.coef[q] / V;
@@ -606,8 +609,8 @@ class Vans {
   /// docs/fluid.md, "Walls".)
   struct GasForm {
     int n = 0;
-    std::size_t face[24];
-    double coef[24];
+    std::size_t face[16];  ///< 8 nodes, one inside an obstacle replaced by at most 2 partners
+    double coef[16];
     double constant = 0;
   };
   GasForm gas_form(int a, const double x[3]) const {
@@ -676,26 +679,32 @@ class Vans {
     return F;
   }
 
-  double gas_velocity(int a, const double x[3]) const {
-    const GasForm F = gas_form(a, x);
+  /// The form's value with the gas velocity u_a as it stands.
+  double value(const GasForm& F, int a) const {
     const std::vector<double>& u = solver_->u(a);
     double v = F.constant;
     for (int q = 0; q < F.n; ++q) v += F.coef[q] * u[F.face[q]];
     return v;
   }
+  double gas_velocity(int a, const double x[3]) const { return value(gas_form(a, x), a); }
 
   /// beta of a particle (a parcel: coarse-grain scaled) with the fluid's
   /// velocity and void fraction at its centre; the velocity into uf if given.
   double particle_beta(const double x[3], const double v[3], double r, double alpha, double* uf,
                        Validity* val = nullptr) const {
-    const VansSolver& f = *solver_;
     double u[3];
     for (int a = 0; a < 3; ++a) u[a] = gas_velocity(a, x);
+    if (uf)
+      for (int a = 0; a < 3; ++a) uf[a] = u[a];
+    return beta_at(x, u, v, r, alpha, val);
+  }
+  /// The same with the gas velocity u at x given.
+  double beta_at(const double x[3], const double u[3], const double v[3], double r, double alpha,
+                 Validity* val) const {
+    const VansSolver& f = *solver_;
     const double e = std::clamp(interpolate(-1, x, f.eps()), eps_min_, 1.0);
     const double slip = std::sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
                                   (u[2] - v[2]) * (u[2] - v[2]));
-    if (uf)
-      for (int a = 0; a < 3; ++a) uf[a] = u[a];
     const auto& s = f.settings();
     if (val) {
       const double d = scaling_ ? 2 * r / alpha : 2 * r;

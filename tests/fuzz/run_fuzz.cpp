@@ -34,6 +34,7 @@
 #include "core/error.hpp"
 #include "flow/particle_flow.hpp"
 #include "geometry/wall_clearance.hpp"
+#include "fuzz_support.hpp"
 #include "loader/plugin_registry.hpp"
 #include "loop/component.hpp"
 #include "scenario/scenario.hpp"
@@ -88,27 +89,8 @@ constexpr std::uint64_t kFluidExchanges = 10;
 /// finding: the hangs are libFuzzer's -timeout, well above it).
 constexpr double kWallSeconds = 3.0;
 
-dp::PluginRegistry& registry() {
-  static dp::PluginRegistry r;
-  static bool loaded = false;
-  if (!loaded) {
-    r.load_directory(DOMEL_FUZZ_PLUGIN_DIR);
-    loaded = true;
-  }
-  return r;
-}
-
-/// The folder each input is written to (relative paths in a scenario resolve
-/// against the meshes and state files bench/fuzz_scenarios.py copied there).
-const std::filesystem::path& work_dir() {
-  static const std::filesystem::path d = [] {
-    const char* env = std::getenv("DOMEL_FUZZ_WORKDIR");
-    std::filesystem::path p = env ? env : std::filesystem::temp_directory_path() / "domel_fuzz";
-    std::filesystem::create_directories(p);
-    return p;
-  }();
-  return d;
-}
+using domel::fuzz::registry;
+using domel::fuzz::work_dir;
 
 /// What happened to the inputs of this process (printed at exit and written
 /// to run_stats_<pid>.txt in the work folder every 100 inputs).

@@ -8,6 +8,7 @@
 // fuzzer then keeps the input), as it does on a sanitizer report, a crash or
 // a hang (libFuzzer's -timeout).
 #include "core/error.hpp"
+#include "fuzz_support.hpp"
 #include "loader/plugin_registry.hpp"
 #include "scenario/scenario.hpp"
 
@@ -25,28 +26,8 @@
 
 namespace {
 
-domel::platform::PluginRegistry& registry() {
-  static domel::platform::PluginRegistry r;
-  static bool loaded = false;
-  if (!loaded) {
-    r.load_directory(DOMEL_FUZZ_PLUGIN_DIR);
-    loaded = true;
-  }
-  return r;
-}
-
-/// The folder each input is written to: its own, so that relative paths in
-/// a scenario (meshes, state files) resolve against the copies the corpus
-/// script put there (scripts in bench/fuzz_scenarios.py).
-const std::filesystem::path& work_dir() {
-  static const std::filesystem::path d = [] {
-    const char* env = std::getenv("DOMEL_FUZZ_WORKDIR");
-    std::filesystem::path p = env ? env : std::filesystem::temp_directory_path() / "domel_fuzz";
-    std::filesystem::create_directories(p);
-    return p;
-  }();
-  return d;
-}
+using domel::fuzz::registry;
+using domel::fuzz::work_dir;
 
 }  // namespace
 

@@ -122,39 +122,50 @@ namespace {
 struct BedResult {
   double gradient;  ///< -dp/dz in the bed [Pa/m]
   double eps;       ///< the bed's mean void fraction as the coupler deposited it
+  json fluid;       ///< summary.json's "fluid"
+};
+
+/// The column a fixed bed stands in: `cells` x `cells` x 20 cells of 5 mm,
+/// side walls of type `side`, run for `duration`.
+struct Column {
+  int cells = 1;
+  std::string side = "slip_wall";
+  double duration = 0.05;
+  std::string backend = "auto";
 };
 
 /// Air rising at superficial velocity us through a bed of fixed 1 mm spheres
-/// on a simple cubic lattice filling [0, 0.005]^2 x [0.02, 0.07] m, in a
-/// column of 1 x 1 x 20 cells of 5 mm whose slip walls make it a slice of an
-/// unbounded bed; after 0.05 s (the flow's relaxation time rho_f eps / K is
-/// below 1e-3 s even at Re_p = 1); measured at the end
-/// from the coupler's fields: the slope of the pressure over the bed's inner
-/// cells (two cells kept clear of each end of the bed).
-BedResult fixed_bed(const std::string& law, double us, const std::string& backend = "auto") {
-  const double d = 1e-3;
+/// on a simple cubic lattice filling the column's cross-section and
+/// 0.02 <= z <= 0.07 m; measured at the end from the coupler's fields: the
+/// slope of the cross-section's mean pressure over the bed's inner cells
+/// (two cells kept clear of each end of the bed) and the mean void fraction
+/// there. The default column (1 x 1 cells between slip walls: a slice of an
+/// unbounded bed) runs 0.05 s: the flow's relaxation time rho_f eps / K is
+/// below 1e-3 s even at Re_p = 1.
+BedResult fixed_bed(const std::string& law, double us, const Column& col = {}) {
+  const double d = 1e-3, w = 0.005 * col.cells;
   json doc = dt::scenario(dt::hertz_mindlin(), 1e-4, 0.5, 0.5, 1e6, 0.3, kRhoP);
   doc["gravity"] = {0, 0, -kG};
-  json box = {{"min", {0, 0, 0.02}}, {"max", {0.005, 0.005, 0.07}}};
+  json box = {{"min", {0, 0, 0.02}}, {"max", {w, w, 0.07}}};
   json insert = {{"model", "lattice"}, {"diameter", d}, {"spacing", 1.0}, {"fixed", true}, {"region", {{"box", box}}}};
   doc["subdomains"][0]["insert"] = json::array({insert});
-  json slip = {{"type", "slip_wall"}};
+  json wall = {{"type", col.side}};
   doc["fluid"] = {{"model", "vans"},
                   {"interval", 1e-4},
-                  {"grid", {{"min", {0, 0, 0}}, {"max", {0.005, 0.005, 0.1}}, {"cells", {1, 1, 20}}}},
+                  {"grid", {{"min", {0, 0, 0}}, {"max", {w, w, 0.1}}, {"cells", {col.cells, col.cells, 20}}}},
                   {"density", kRhoF},
                   {"viscosity", kMu},
                   {"boundaries",
-                   {{"x_min", slip}, {"x_max", slip}, {"y_min", slip}, {"y_max", slip},
+                   {{"x_min", wall}, {"x_max", wall}, {"y_min", wall}, {"y_max", wall},
                     {"z_min", {{"type", "velocity_inlet"}, {"velocity", {0, 0, us}}}},
                     {"z_max", {{"type", "pressure_outlet"}}}}},
                   {"drag", {{"law", law}}},
                   {"initial_velocity", {0, 0, us}},
                   {"write_interval", 0},
-                  {"solver", {{"backend", backend}}}};
-  doc["run"] = {{"duration", 0.05}};
+                  {"solver", {{"backend", col.backend}}}};
+  doc["run"] = {{"duration", col.duration}};
   auto sim = dt::build(doc);
-  run(*sim, "bed");
+  const dp::RunResult result = run(*sim, "bed");
   domel_fluid_fields_v1 f{};
   EXPECT_TRUE(sim->fluid->spec().model->fluid_fields(f));
   const double* p = nullptr;
@@ -168,75 +179,22 @@ BedResult fixed_bed(const std::string& law, double us, const std::string& backen
   // particle in the outer half of cell 5 sees some of cell 4's looser
   // packing, and its smaller beta lowers K on the face between cells 5 and
   // 6: the faces of uniform K are those between cells 6 and 11.
-  double sz = 0, sp = 0, szz = 0, szp = 0, se = 0;
-  int n = 0;
-  for (int k = 6; k <= 11; ++k) {
-    const double z = (k + 0.5) * 0.005;
-    const std::size_t c = static_cast<std::size_t>(k);  // cell (0, 0, k)
-    sz += z, sp += p[c], szz += z * z, szp += z * p[c], se += e[c];
-    ++n;
-  }
-  const double slope = (n * szp - sz * sp) / (n * szz - sz * sz);
-  // the hydrostatic part of p is rho_f g per metre; the bed's drag is the rest
-  return {-(slope + kRhoF * kG), se / n};
-}
-
-/// Air rising at superficial velocity us through a bed of fixed 1 mm spheres
-/// on a simple cubic lattice filling [0, 0.02]^2 x [0.02, 0.07] m (20 x 20 x 50
-/// spheres: 20 diameters wide), in a column of 4 x 4 x 20 cells of 5 mm whose
-/// side walls are `side` ("wall": no-slip; "slip_wall"), after 0.02 s (the
-/// gas relaxes in rho_f eps / K, below 1e-4 s here): the
-/// cross-section's mean pressure gradient over the bed's inner cells (as in
-/// fixed_bed), the mean void fraction there, and the coupler's summary.
-struct WalledBed {
-  BedResult bed;
-  json fluid;  ///< summary.json's "fluid"
-};
-WalledBed walled_bed(const std::string& law, double us, const std::string& side) {
-  const double d = 1e-3;
-  json doc = dt::scenario(dt::hertz_mindlin(), 1e-4, 0.5, 0.5, 1e6, 0.3, kRhoP);
-  doc["gravity"] = {0, 0, -kG};
-  json box = {{"min", {0, 0, 0.02}}, {"max", {0.02, 0.02, 0.07}}};
-  json insert = {{"model", "lattice"}, {"diameter", d}, {"spacing", 1.0}, {"fixed", true}, {"region", {{"box", box}}}};
-  doc["subdomains"][0]["insert"] = json::array({insert});
-  json wall = {{"type", side}};
-  doc["fluid"] = {{"model", "vans"},
-                  {"interval", 1e-4},
-                  {"grid", {{"min", {0, 0, 0}}, {"max", {0.02, 0.02, 0.1}}, {"cells", {4, 4, 20}}}},
-                  {"density", kRhoF},
-                  {"viscosity", kMu},
-                  {"boundaries",
-                   {{"x_min", wall}, {"x_max", wall}, {"y_min", wall}, {"y_max", wall},
-                    {"z_min", {{"type", "velocity_inlet"}, {"velocity", {0, 0, us}}}},
-                    {"z_max", {{"type", "pressure_outlet"}}}}},
-                  {"drag", {{"law", law}}},
-                  {"initial_velocity", {0, 0, us}},
-                  {"write_interval", 0}};
-  doc["run"] = {{"duration", 0.02}};
-  auto sim = dt::build(doc);
-  const dp::RunResult result = run(*sim, "walled_bed");
-  domel_fluid_fields_v1 f{};
-  EXPECT_TRUE(sim->fluid->spec().model->fluid_fields(f));
-  const double* p = nullptr;
-  const double* e = nullptr;
-  for (uint32_t k = 0; k < f.field_count; ++k) {
-    if (std::string(f.names[k]) == "pressure") p = f.data[k];
-    if (std::string(f.names[k]) == "void_fraction") e = f.data[k];
-  }
+  const std::size_t layer = static_cast<std::size_t>(col.cells) * static_cast<std::size_t>(col.cells);
   double sz = 0, sp = 0, szz = 0, szp = 0, se = 0;
   int n = 0;
   for (int k = 6; k <= 11; ++k) {
     const double z = (k + 0.5) * 0.005;
     double pl = 0, el = 0;
-    for (int c = 0; c < 16; ++c) {  // the layer's 4 x 4 cells
-      pl += p[static_cast<std::size_t>(c) + 16u * static_cast<std::size_t>(k)] / 16;
-      el += e[static_cast<std::size_t>(c) + 16u * static_cast<std::size_t>(k)] / 16;
+    for (std::size_t c = 0; c < layer; ++c) {
+      pl += p[c + layer * static_cast<std::size_t>(k)] / static_cast<double>(layer);
+      el += e[c + layer * static_cast<std::size_t>(k)] / static_cast<double>(layer);
     }
     sz += z, sp += pl, szz += z * z, szp += z * pl, se += el;
     ++n;
   }
   const double slope = (n * szp - sz * sp) / (n * szz - sz * sz);
-  return {{-(slope + kRhoF * kG), se / n}, result.summary["fluid"]};
+  // the hydrostatic part of p is rho_f g per metre; the bed's drag is the rest
+  return {-(slope + kRhoF * kG), se / n, result.summary["fluid"]};
 }
 
 /// A homogeneous bed's pressure gradient under model A: eps dp/dz = -n F,
@@ -310,12 +268,13 @@ TEST(FluidVans, AFixedBedBetweenNoSlipWallsFollowsErgunAndTheExchangeIsExact) {
            {"wall", 20.0}, {"wall", 280.0}, {"slip_wall", 100.0}}) {
     {
       const double us = re * kMu / (kRhoF * d);
-      const WalledBed r = walled_bed("gidaspow", us, side);
-      const double ergun = fl::ergun_pressure_gradient(us, r.bed.eps, d, kRhoF, kMu);
+      // 20 diameters wide; 0.02 s: the gas relaxes in rho_f eps / K, below 1e-4 s here
+      const BedResult r = fixed_bed("gidaspow", us, Column{4, side, 0.02});
+      const double ergun = fl::ergun_pressure_gradient(us, r.eps, d, kRhoF, kMu);
       std::printf("[walled bed] %s Re_p %g: eps %.4f, -dp/dz %.5g Pa/m, Ergun %.5g (%+.2e); residual %.3g, wall "
-                  "shear %s N\n", side, re, r.bed.eps, r.bed.gradient, ergun, r.bed.gradient / ergun - 1,
+                  "shear %s N\n", side, re, r.eps, r.gradient, ergun, r.gradient / ergun - 1,
                   r.fluid.value("momentum_residual", -1.0), r.fluid.value("wall_shear_N", json()).dump().c_str());
-      EXPECT_NEAR(r.bed.gradient, ergun, 0.05 * ergun) << side << " at Re_p " << re;
+      EXPECT_NEAR(r.gradient, ergun, 0.05 * ergun) << side << " at Re_p " << re;
       EXPECT_LT(r.fluid.value("momentum_residual", 1.0), 1e-12) << side << " at Re_p " << re;
     }
   }
@@ -328,12 +287,12 @@ TEST(FluidVans, MultigridAndConjugateGradientSolvesAgree) {
   const double us = 20 * kMu / (kRhoF * 1e-3);
   BedResult pfmg{};
   try {
-    pfmg = fixed_bed("gidaspow", us, "pfmg");
+    pfmg = fixed_bed("gidaspow", us, Column{1, "slip_wall", 0.05, "pfmg"});
   } catch (const dp::ConfigError& e) {
     if (std::string(e.what()).find("needs hypre") != std::string::npos) GTEST_SKIP() << e.what();
     throw;
   }
-  const BedResult cg = fixed_bed("gidaspow", us, "cg");
+  const BedResult cg = fixed_bed("gidaspow", us, Column{1, "slip_wall", 0.05, "cg"});
   std::printf("[pressure solves] -dp/dz cg %.9g, pfmg %.9g Pa/m\n", cg.gradient, pfmg.gradient);
   EXPECT_NEAR(pfmg.gradient, cg.gradient, 1e-6 * cg.gradient);
 }
