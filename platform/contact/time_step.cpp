@@ -38,8 +38,14 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
   // 2(sqrt(1+zeta^2) - zeta)/omega_theta, omega_theta = sqrt(k_theta/I_red)
   // (docs/physics.md §3.6).
   auto collide = [&](const domel_pair_v2& pair, const ModelInstance* rolling_model, double r_i, double r_j, double m_i, double m_j, double m_eff,
-                     double i_red, double& t_contact, double& dt_crit, bool& rolling_sets_limit) {
+                     double i_red, double& t_contact, double& dt_crit, bool& rolling_sets_limit, bool& through) {
     const double r_eff = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
+    // The overlap at which the spheres' centres meet (a wall: the centre
+    // reaches its surface). A contact still approaching there has not stopped
+    // the impact: the collision ends there, reported as passing through (a
+    // contact far too soft for the impact velocity would otherwise be
+    // integrated for the step cap without ending).
+    const double delta_through = r_j > 0 ? r_i + r_j : r_i;
     // Integrate delta'' = -F_n(delta, delta')/m* from first touch until the
     // contact opens, with a step refined until the duration converges.
     double h = 1e-3 * r_eff / impact_velocity;
@@ -47,6 +53,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     for (int refine = 0; refine < 12; ++refine) {
       double delta = 0.0, v = impact_velocity, t = 0.0, crit = 1e300;
       bool rolling = false;
+      through = false;
       auto force = [&](double d, double vel) {
         buf.overlap[0] = std::max(d, 1e-300);
         buf.r_eff[0] = r_eff; buf.m_eff[0] = m_eff; buf.radius_i[0] = r_i; buf.radius_j[0] = r_j;
@@ -82,6 +89,10 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
         v += 0.5 * h * a;
         t += h;
         ++n;
+        if (!(delta < delta_through)) {  // NaN included
+          through = true;
+          break;
+        }
       } while (delta > 0.0 && n < 2000000);
       t_contact = t;
       dt_crit = crit;
@@ -94,7 +105,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     std::fill(buf.history.begin(), buf.history.end(), 0.0);
   };
   double tc, crit;
-  bool rolling = false;
+  bool rolling = false, through = false;
   first = true;
   // "particle-particle contact", or with several materials the pair's names
   auto pair_name = [&](std::size_t a, std::size_t b) {
@@ -102,6 +113,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
                       : "contact of " + (*in.materials)[a].name + " with " + (*in.materials)[b].name;
   };
   auto keep = [&](const std::string& what) {
+    if (through) rep.passes_through += (rep.passes_through.empty() ? "" : ", ") + what;
     if (first || tc < rep.contact_time) rep.contact_time = tc;
     if (first || crit < rep.critical) {
       rep.critical = crit;
@@ -116,12 +128,12 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     for (std::size_t b = a; b < n_mat; ++b) {
       if (smallest[b] == SIZE_MAX) continue;
       if (b == a) {  // a pair of equal spheres: m* = m/2, the relative rolling mode's inertia I/2
-        collide((*in.pairs)[a * n_mat + a], (*in.pair_rolling)[a * n_mat + a], ra, ra, ma, ma, 0.5 * ma, 0.5 * ia, tc, crit, rolling);
+        collide((*in.pairs)[a * n_mat + a], (*in.pair_rolling)[a * n_mat + a], ra, ra, ma, ma, 0.5 * ma, 0.5 * ia, tc, crit, rolling, through);
       } else {
         const double rb = s.radius[smallest[b]], mb = s.mass[smallest[b]];
         const double ib = 0.4 * mb * rb * rb;
         collide((*in.pairs)[a * n_mat + b], (*in.pair_rolling)[a * n_mat + b], ra, rb, ma, mb, ma * mb / (ma + mb), ia * ib / (ia + ib), tc, crit,
-                rolling);
+                rolling, through);
       }
       keep(pair_name(a, b));
     }
@@ -130,7 +142,7 @@ TimeStepReport estimate_time_step(const TimeStepInputs& in, const ParticleStore&
     for (std::size_t a = 0; a < n_mat; ++a) {
       if (smallest[a] == SIZE_MAX) continue;
       const double ra = s.radius[smallest[a]], ma = s.mass[smallest[a]];
-      collide((*in.wall_pairs)[w * n_mat + a], (*in.wall_pair_rolling)[w * n_mat + a], ra, 0.0, ma, 0.0, ma, 0.4 * ma * ra * ra, tc, crit, rolling);
+      collide((*in.wall_pairs)[w * n_mat + a], (*in.wall_pair_rolling)[w * n_mat + a], ra, 0.0, ma, 0.0, ma, 0.4 * ma * ra * ra, tc, crit, rolling, through);
       keep(std::string("contact with wall '") + (*in.walls)[w].name + "'" +
            (n_mat == 1 ? "" : " (" + (*in.materials)[a].name + ")"));
     }

@@ -23,6 +23,10 @@ struct TimeStepReport {
   double contact_time = 0;   ///< shortest simulated collision at the impact velocity [s]
   double critical = 0;       ///< explicit stability limit 2/omega (damped) of the stiffest contact [s]
   std::string critical_of;   ///< which contact sets it ("particle-particle", "wall 'x'")
+  /// The contacts that did not stop the impact before the centres met (a
+  /// wall: the centre reached its surface), comma-separated; their contact
+  /// time is the time to that point. Empty when every contact stopped it.
+  std::string passes_through;
   double chosen = 0;         ///< [s]
   std::string reason;
 };

@@ -463,13 +463,29 @@ bool set_time_step(Build& b, Subdomain& sub, const json& sd, const std::string& 
       ++probes;
     }
   const bool probe_particle = probes > 0;
+  double d_min = 0;  // the smallest diameter the estimate collides, for its messages
+  for (std::size_t k = 0; k < sub.store().size(); ++k)
+    if (k == 0 || 2 * sub.store().radius[k] < d_min) d_min = 2 * sub.store().radius[k];
+  auto drop_probes = [&] {
+    for (std::size_t k = 0; k < probes; ++k) sub.store().swap_remove(sub.store().size() - 1);
+    probes = 0;
+  };
   try {
     rep = sub.estimate_time_step(v_imp);
   } catch (const PluginError& e) {
-    ck.add(base + "/contact", std::string("the contact model failed while estimating the time step: ") + e.what());
+    drop_probes();
+    ck.add(base + "/contact",
+           fmt::format("the contact model failed while estimating the time step (smallest particle {:.6g} m across, "
+                       "impact velocity {:.6g} m/s): {}",
+                       d_min, v_imp, e.what()));
     return false;
   }
-  for (std::size_t k = 0; k < probes; ++k) sub.store().swap_remove(sub.store().size() - 1);
+  drop_probes();
+  if (!rep.passes_through.empty())
+    spdlog::warn("subdomain '{}': the {} does not stop an impact at {:.3g} m/s (impact_velocity) within the "
+                 "particles' size ({:.3g} m, the smallest): a contact too soft for that speed; the estimate's contact "
+                 "time is the time to pass through ({:.3g} s)",
+                 sd_name, rep.passes_through, v_imp, d_min, rep.contact_time);
   const json& ts = sd["time_step"];
   const std::optional<double> given = ts.is_number() ? std::optional<double>(ts.get<double>()) : std::nullopt;
   if (const TimeStepProblem p =

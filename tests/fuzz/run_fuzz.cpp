@@ -155,16 +155,12 @@ void note_run_error(const char* kind, const std::string& what) {
 /// Knobs that make a scenario slow to load or run, with the most the harness
 /// runs: an input above one is not loaded (a jammed region with 10^9
 /// insertion attempts per particle takes hours as the user asked; libFuzzer
-/// would report it as a hang). Defaults: 1000, 1000, 16, 2000, 1 m/s. An
-/// impact velocity far above the contact's reach makes the time-step estimate
-/// integrate each contact for its cap of 2e6 steps, 20-30 s under the
-/// sanitizers (docs/reliability.md: an open finding).
+/// would report it as a hang). Defaults: 1000, 1000, 16, 2000.
 const std::vector<std::pair<std::string, double>>& cost_knobs() {
   static const std::vector<std::pair<std::string, double>> knobs = {{"max_attempts", 1e4},
                                                                     {"insertion_attempts", 1e4},
                                                                     {"max_substeps", 64},
-                                                                    {"max_iterations", 1e4},
-                                                                    {"impact_velocity", 1e3}};
+                                                                    {"max_iterations", 1e4}};
   return knobs;
 }
 

@@ -208,3 +208,28 @@ TEST(RollingTimeStep, HertzLimitAtTheImpactsMaximumOverlap) {
     EXPECT_THROW(dt::build(scenario(dt::hertz_mindlin(), theta_c, 1.0, given, wall)), ConfigError);
   }
 }
+
+TEST(TimeStepEstimate, AContactTooSoftToStopTheImpactEndsWhereTheSpheresPassThrough) {
+  // Found by run-time fuzzing (docs/reliability.md): a linear stiffness of
+  // 1e-6 N/m cannot stop an impact at 1 m/s; the estimate integrated every
+  // contact for its step cap (2e6 steps) without the approach ending. It now
+  // ends where the centres meet (a wall: where the centre reaches it) and
+  // names the contacts. Expected contact time: the spheres keep their speed
+  // (k = 1e-6 N/m, m* = m/2 = 1.4e-5 kg: omega = 0.27 rad/s, so over the 2.8 ms
+  // to pass the speed changes by (omega t)^2/2 ~ 3e-7; e = 1, no dashpot):
+  // t = (R + R)/v for the pair, R/v for the wall. Tolerance 1e-3: one step of
+  // the estimator's coarsest integration is 1e-3 R*/v.
+  const double v = 1.0;  // impact_velocity default
+  for (bool wall : {false, true}) {
+    const auto rep = auto_report(dt::linear_spring(1e-6), 10.0, 1.0, wall);
+    const double expected = wall ? kR / v : kD / v;
+    std::printf("[k = 1e-6 N/m %s] contact time %.6e s (pass-through %.6e), passes through: '%s'; auto dt %.4e (%s)\n",
+                wall ? "with wall" : "no wall  ", rep.contact_time, expected, rep.passes_through.c_str(), rep.chosen,
+                rep.reason.c_str());
+    EXPECT_NEAR(rep.contact_time, expected, 1e-3 * expected);
+    EXPECT_EQ(rep.passes_through,
+              wall ? "particle-particle contact, contact with wall 'floor'" : "particle-particle contact");
+  }
+  // a contact that stops the impact is not reported
+  EXPECT_EQ(auto_report(dt::linear_spring(kK), 10.0, 0.5, true).passes_through, "");
+}
