@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The built-in pressure solve: Eigen's conjugate gradient with an incomplete
 // Cholesky preconditioner on the SPD 7-point system of vans_solver.hpp,
-// warm-started from the previous correction. Adequate for the grids of the
+// warm-started from the previous correction; the preconditioner is kept
+// while the system's matrix stays the same (a gas step without particles, or
+// with the same drag and void fraction). Adequate for the grids of the
 // validation cases (up to ~10^5 cells); its cost per cell grows with the grid
 // (docs/fluid.md, "Pressure solve"), which a multigrid back end removes.
 #pragma once
@@ -22,21 +24,24 @@ class PressureCg {
 
   SolveReport operator()(const PressureSystem& sys, std::vector<double>& x) {
     const Eigen::Index n = static_cast<Eigen::Index>(sys.diag.size());
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(sys.diag.size() * 7);
-    // scaled by the diagonal's mean so that the tolerance is relative and
-    // the preconditioner's shift is well-sized
-    for (std::size_t r = 0; r < sys.diag.size(); ++r) {
-      t.emplace_back(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r), sys.diag[r]);
-      for (const auto& [c, v] : sys.off[r]) t.emplace_back(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c), v);
-    }
-    Eigen::SparseMatrix<double> A(n, n);
-    A.setFromTriplets(t.begin(), t.end());
     Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(sys.rhs.data(), n);
     if (last_.size() != n) last_ = Eigen::VectorXd::Zero(n);
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                             Eigen::IncompleteCholesky<double>>
-        cg;
+    const bool same = A_.rows() == n && sys.diag == diag_ && sys.off == off_;
+    if (!same) {
+      std::vector<Eigen::Triplet<double>> t;
+      t.reserve(sys.diag.size() * 7);
+      for (std::size_t r = 0; r < sys.diag.size(); ++r) {
+        t.emplace_back(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(r), sys.diag[r]);
+        for (const auto& [c, v] : sys.off[r])
+          t.emplace_back(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c), v);
+      }
+      A_.resize(n, n);
+      A_.setFromTriplets(t.begin(), t.end());
+      diag_ = sys.diag;
+      off_ = sys.off;
+      factored_ = false;
+    }
+    auto& cg = cg_;
     // relative to |b|, but never below tol x the system's reference norm
     const double bn = sys.rhs_norm();
     cg.setTolerance(sys.relative_tolerance(tol_, bn));
@@ -44,7 +49,8 @@ class PressureCg {
     Eigen::VectorXd sol = Eigen::VectorXd::Zero(n);
     const bool trivial = sys.trivial(tol_, bn);
     if (!trivial) {
-      cg.compute(A);
+      if (!factored_) cg.compute(A_);
+      factored_ = true;
       sol = cg.solveWithGuess(b, last_);
     }
     last_ = sol;
@@ -65,6 +71,12 @@ class PressureCg {
   double tol_;
   int max_;
   Eigen::VectorXd last_;
+  Eigen::SparseMatrix<double> A_;  ///< the matrix factored, kept while diag_ and off_ hold
+  std::vector<double> diag_;
+  std::vector<std::vector<std::pair<std::size_t, double>>> off_;
+  bool factored_ = false;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>>
+      cg_;
 };
 
 }  // namespace domel::plugins::fluid

@@ -64,7 +64,7 @@ class Vans {
       "required": ["min", "max", "cells"], "additionalProperties": false },
     "density": { "type": "number", "exclusiveMinimum": 0, "x-unit": "kg/m^3", "description": "fluid density rho_f (air: 1.2)" },
     "viscosity": { "type": "number", "exclusiveMinimum": 0, "x-unit": "Pa s", "description": "dynamic viscosity mu (air: 1.8e-5)" },
-    "boundaries": { "type": "object", "default": {}, "description": "each side of the box: {\"type\": \"wall\"} (no slip, the default), {\"type\": \"slip_wall\"} (no shear: a plane of symmetry), {\"type\": \"velocity_inlet\", \"velocity\": [..], \"patch\": {\"min\": [..], \"max\": [..]}} (the velocity is superficial: eps u across the face; the patch optional: the whole side), or {\"type\": \"pressure_outlet\", \"pressure\": p}; at least one outlet",
+    "boundaries": { "type": "object", "default": {}, "description": "each side of the box: {\"type\": \"wall\"} (no slip, the default; \"velocity\": [..] makes it a wall moving along itself, a lid or a belt), {\"type\": \"slip_wall\"} (no shear: a plane of symmetry), {\"type\": \"velocity_inlet\", \"velocity\": [..], \"patch\": {\"min\": [..], \"max\": [..]}} (the velocity is superficial: eps u across the face; the patch optional: the whole side), or {\"type\": \"pressure_outlet\", \"pressure\": p}; at least one outlet",
       "properties": {
         "x_min": { "$ref": "#/$defs/side" }, "x_max": { "$ref": "#/$defs/side" },
         "y_min": { "$ref": "#/$defs/side" }, "y_max": { "$ref": "#/$defs/side" },
@@ -90,7 +90,8 @@ class Vans {
     "void_fraction_min": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.3, "x-unit": "1", "description": "eps is clamped to at least this in the fluid equations and the drag laws" },
     "substeps": { "oneOf": [ { "type": "integer", "minimum": 1, "maximum": 1000000 }, { "const": "auto" } ], "default": 1, "description": "fluid steps per coupling interval, or \"auto\": at every exchange the fewest steps (up to max_substeps) that keep the fluid step within its advective (cfl) and viscous limits for the flow as it stands" },
     "max_substeps": { "type": "integer", "minimum": 1, "maximum": 1000000, "default": 16, "description": "with substeps \"auto\": the most fluid steps per coupling interval; the interval is refused (with the limit named) when even these are not enough" },
-    "cfl": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5, "x-unit": "1", "description": "advective Courant number limit of a fluid step, sum_a |u_a| dt / dx_a (first-order upwind)" },
+    "cfl": { "type": "number", "exclusiveMinimum": 0, "maximum": 1, "default": 0.5, "x-unit": "1", "description": "advective Courant number limit of a fluid step, sum_a |u_a| dt / dx_a (0.5 keeps van Leer's scheme TVD with the explicit step)" },
+    "advection": { "enum": ["upwind", "van_leer"], "default": "upwind", "description": "advection scheme of the gas momentum: upwind = first order (numerical viscosity |u| dx / 2, robust); van_leer = second order where the flow is smooth, limited at extrema (TVD), for wakes and recirculations (docs/validation/gas-solver.md)" },
     "initial_velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "fluid velocity at the start" },
     "solver": { "type": "object", "default": {}, "properties": {
         "backend": { "enum": ["auto", "cg", "pfmg"], "default": "auto", "description": "pressure solve: cg = Eigen's conjugate gradient with incomplete Cholesky (cost per cell grows with the grid); pfmg = hypre's structured multigrid (PFMG-preconditioned CG; cost per cell about constant; needs a domel built with Debian's libhypre-dev); auto = pfmg when available, else cg" },
@@ -104,6 +105,7 @@ class Vans {
     "side": { "type": "object", "properties": {
         "type": { "enum": ["wall", "slip_wall", "velocity_inlet", "pressure_outlet"] },
         "velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m/s" },
+        "profile": { "enum": ["uniform", "parabolic"], "default": "uniform", "description": "velocity_inlet: uniform, or the parabolic profile of a developed laminar flow across the side (or patch) along each tangential axis of more than one cell, 'velocity' at its centre (a channel's mean is 2/3 of it)" },
         "patch": { "type": "object", "properties": {
             "min": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m" },
             "max": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "x-unit": "m" } },
@@ -143,10 +145,17 @@ class Vans {
       Boundary& out = s.sides[side];
       const std::string type = b.at("type").get<std::string>();
       const std::string where = std::string("boundaries/") + kSideNames[side];
+      if (type == "wall" && b.contains("velocity")) {  // a wall moving along itself
+        for (int d = 0; d < 3; ++d) out.velocity[d] = b["velocity"][d].get<double>();
+        if (out.velocity[side / 2] != 0)
+          throw sdk::ParameterError(where + ": a wall moves only along itself; its velocity along " +
+                                    std::string(1, "xyz"[side / 2]) + " must be 0");
+      }
       if (type == "velocity_inlet") {
         out.type = Boundary::velocity_inlet;
         if (!b.contains("velocity")) throw sdk::ParameterError(where + ": a velocity_inlet needs 'velocity'");
         for (int d = 0; d < 3; ++d) out.velocity[d] = b["velocity"][d].get<double>();
+        out.parabolic = b.value("profile", std::string("uniform")) == "parabolic";
         if (b.contains("patch")) {
           out.patch = true;
           for (int d = 0; d < 3; ++d) {
@@ -160,8 +169,10 @@ class Vans {
       } else if (type == "slip_wall") {
         out.type = Boundary::slip_wall;
       }
-      if (type != "velocity_inlet" && (b.contains("velocity") || b.contains("patch")))
-        throw sdk::ParameterError(where + ": 'velocity' and 'patch' belong to a velocity_inlet, not a " + type);
+      if (type != "velocity_inlet" && (b.contains("patch") || b.value("profile", std::string("uniform")) != "uniform"))
+        throw sdk::ParameterError(where + ": 'patch' and a 'profile' belong to a velocity_inlet, not a " + type);
+      if (type != "velocity_inlet" && type != "wall" && b.contains("velocity"))
+        throw sdk::ParameterError(where + ": 'velocity' belongs to a velocity_inlet or a (moving) wall, not a " + type);
       if (type != "pressure_outlet" && b.contains("pressure"))
         throw sdk::ParameterError(where + ": 'pressure' belongs to a pressure_outlet, not a " + type);
     }
@@ -193,6 +204,7 @@ class Vans {
     pressure_force_ = j.value("pressure_gradient_force", true);
     two_way_ = j.value("coupling", std::string("two_way")) == "two_way";
     eps_min_ = j.value("void_fraction_min", 0.3);
+    s.advection = j.value("advection", std::string("upwind")) == "van_leer" ? Advection::van_leer : Advection::upwind;
     if (j.contains("substeps") && j["substeps"].is_string()) {
       auto_substeps_ = true;
       substeps_ = 1;

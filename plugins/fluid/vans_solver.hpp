@@ -16,7 +16,8 @@
 // (Chorin 1968; Spalding's partial elimination for the drag):
 //
 //   predictor   rho_f eps^{n+1} (u* - u^n)/dt = R^n - K (u* - u_s)
-//               with R^n = -rho_f eps (u^n . grad) u^n   (first-order upwind)
+//               with R^n = -rho_f eps (u^n . grad) u^n   (first-order upwind,
+//                          or van Leer's limited upwind-biased one: below)
 //                          + mu eps lap u^n - eps grad p^n + rho_f eps g,
 //               so u* = (rho_f eps u^n/dt + R^n + K u_s) / (rho_f eps/dt + K)
 //               face by face: the drag is implicit, no limit from K;
@@ -25,16 +26,29 @@
 //               a symmetric positive-definite 7-point system (solved by the
 //               caller's PressureSolver), then p^{n+1} = p^n + p'.
 //
+// Advection: (u . grad) u_a at a face is sum_b u_b (phi_{+1/2} - phi_{-1/2}) / h_b,
+// with phi the value of u_a halfway to the next face along b, taken from the
+// upwind side: first-order upwind takes the upwind face's value; van Leer
+// (1974, J. Comput. Phys. 14:361) adds the limited slope, phi_{+1/2} = u_0 +
+// psi(r) (u_1 - u_0) / 2 with psi(r) = (r + |r|) / (1 + |r|), r = (u_0 -
+// u_{-1}) / (u_1 - u_0): second order where the profile is smooth, first
+// order at extrema, no new extrema (TVD). Its 5-point stencil takes the
+// boundaries' ghost values two faces out (mirrored), and falls back to
+// upwind beside an obstacle. docs/validation/gas-solver.md checks both.
+//
 // Boundaries, per side of the box: no-slip wall (normal velocity 0, the
-// tangential one mirrored), slip wall (normal velocity 0, no shear: a plane
+// tangential one mirrored about the wall's own tangential velocity, zero
+// unless it moves: a lid), slip wall (normal velocity 0, no shear: a plane
 // of symmetry), velocity inlet over the whole side or a patch of
 // it (the rest of the side is wall; the velocity given is superficial, so
 // eps u = U across the face even where particles sit on it), pressure outlet (p fixed half a cell
 // outside the last cell centre, zero gradient of the velocity). Blocked cells
 // (obstacles) are no-slip walls on every face: the tangential velocity inside
 // an obstacle is the mirror of the flow's, as beyond a wall side of the box.
-// At least one outlet is required: it fixes the pressure level, so the
-// system is non-singular.
+// A box with an outlet has its pressure level fixed there; a closed box
+// (walls only: a cavity) pins the pressure correction of its first fluid
+// cell, whose own continuity then follows from the others' (the box's net
+// flux is zero). Inlets without an outlet are refused.
 #pragma once
 
 #include "plugins/fluid/mac_grid.hpp"
@@ -55,11 +69,18 @@ constexpr const char* kSideNames[6] = {"x_min", "x_max", "y_min", "y_max", "z_mi
 
 struct Boundary {
   enum Type { wall, slip_wall, velocity_inlet, pressure_outlet } type = wall;
-  std::array<double, 3> velocity{0, 0, 0};  ///< inlet velocity [m/s]
+  std::array<double, 3> velocity{0, 0, 0};  ///< inlet velocity, or a no-slip wall's tangential one [m/s]
   bool patch = false;                       ///< inlet over a patch only
+  /// inlet: the laminar profile of a developed flow, velocity x the product
+  /// of 4 s (1 - s) over the side's (or patch's) tangential axes of more than
+  /// one cell (s: 0 to 1 across it); `velocity` is then the centre's
+  bool parabolic = false;
   std::array<double, 3> patch_lo{0, 0, 0}, patch_hi{0, 0, 0};
   double pressure = 0;                      ///< outlet pressure [Pa]
 };
+
+/// The advection scheme of the momentum equation (see the top of this file).
+enum class Advection { upwind, van_leer };
 
 /// The face's role: free (solved: interior between two fluid cells, or on an
 /// outlet) or fixed (wall, inlet, a face of a blocked cell).
@@ -106,15 +127,23 @@ class VansSolver {
     double mu = 1.8e-5; ///< [Pa s]
     std::array<double, 3> gravity{0, 0, 0};
     std::array<double, 3> initial_velocity{0, 0, 0};
+    Advection advection = Advection::upwind;
   };
 
   VansSolver(Settings s, std::vector<std::uint8_t> blocked) : s_(std::move(s)), blocked_(std::move(blocked)) {
     const MacGrid& g = s_.grid;
     if (blocked_.empty()) blocked_.assign(g.cells(), 0);
     if (blocked_.size() != g.cells()) throw std::invalid_argument("blocked cells do not match the grid");
-    bool outlet = false;
-    for (const auto& b : s_.sides) outlet = outlet || b.type == Boundary::pressure_outlet;
-    if (!outlet) throw std::invalid_argument("no pressure outlet: the pressure has no reference level");
+    bool outlet = false, inlet = false;
+    for (int side = 0; side < 6; ++side) {
+      const Boundary& b = s_.sides[side];
+      outlet = outlet || b.type == Boundary::pressure_outlet;
+      inlet = inlet || b.type == Boundary::velocity_inlet;
+      if (b.type == Boundary::wall && b.velocity[side / 2] != 0)
+        throw std::invalid_argument(std::string("the wall ") + kSideNames[side] + " moves across itself");
+    }
+    if (inlet && !outlet) throw std::invalid_argument("an inlet without a pressure outlet: the gas cannot leave");
+    closed_ = !outlet;
     eps_.assign(g.cells(), 1.0);
     eps_old_ = eps_;
     p_.assign(g.cells(), 0.0);
@@ -143,6 +172,17 @@ class VansSolver {
   void set_gravity(const std::array<double, 3>& gravity) {
     s_.gravity = gravity;
     const MacGrid& g = s_.grid;
+    if (closed_) {  // hydrostatic about the box's centre
+      for (int k = 0; k < g.n[2]; ++k)
+        for (int j = 0; j < g.n[1]; ++j)
+          for (int i = 0; i < g.n[0]; ++i) {
+            const double x[3] = {g.centre(0, i), g.centre(1, j), g.centre(2, k)};
+            double p = 0;
+            for (int d = 0; d < 3; ++d) p += s_.rho * s_.gravity[d] * (x[d] - 0.5 * (g.lo[d] + g.hi(d)));
+            p_[g.cell(i, j, k)] = p;
+          }
+      return;
+    }
     for (int side = 0; side < 6; ++side)
       if (s_.sides[side].type == Boundary::pressure_outlet) {
         const int a = side / 2;
@@ -245,12 +285,24 @@ class VansSolver {
         if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
         const double ef1 = face_eps(e1, a, i, j, k);
         const double un = u_[a][f];
-        // advection (first-order upwind) and diffusion of u_a
+        // advection (upwind or van Leer) and diffusion of u_a
         double adv = 0, lap = 0;
         for (int b = 0; b < 3; ++b) {
           const double ub = (b == a) ? un : cross_velocity(a, b, i, j, k);
           const double um = neighbour(a, b, -1, i, j, k), up = neighbour(a, b, +1, i, j, k);
-          adv += ub > 0 ? ub * (un - um) / g.h[b] : ub * (up - un) / g.h[b];
+          double u2[2];  // u_a two faces back and ahead along b
+          if (s_.advection == Advection::van_leer && second_neighbours(a, b, i, j, k, u2)) {
+            // the limited slope's half, van Leer's harmonic mean of the two differences
+            auto half_slope = [](double d1, double d2) {
+              const double p = d1 * d2;
+              return p > 0 ? p / (d1 + d2) : 0.0;
+            };
+            const double hi_face = ub > 0 ? un + half_slope(un - um, up - un) : up - half_slope(u2[1] - up, up - un);
+            const double lo_face = ub > 0 ? um + half_slope(um - u2[0], un - um) : un - half_slope(up - un, un - um);
+            adv += ub * (hi_face - lo_face) / g.h[b];
+          } else {
+            adv += ub > 0 ? ub * (un - um) / g.h[b] : ub * (up - un) / g.h[b];
+          }
           lap += (up - 2 * un + um) / (g.h[b] * g.h[b]);
         }
         const double gradp = face_gradient(p_, a, i, j, k, kd);
@@ -296,6 +348,12 @@ class VansSolver {
           }
           sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
         }
+    if (closed_) {  // p' = 0 in the first fluid cell: its row and column leave the system
+      sys.off[0].clear();
+      sys.rhs[0] = 0;
+      for (auto& row : sys.off)
+        row.erase(std::remove_if(row.begin(), row.end(), [](const auto& e) { return e.first == 0; }), row.end());
+    }
     {
       // the flow's own rate of strain (or 1 mm/s over a cell at rest), over
       // the whole system: the solve stops at the tolerance times this, so a
@@ -427,7 +485,7 @@ class VansSolver {
   /// The force of the box's no-slip side walls on the fluid [N]: for each
   /// face next to such a wall and tangential to it, the viscous term the
   /// step applies there towards the wall, mu eps (u_ghost - u) / h^2 over the
-  /// face's control volume, with the wall's ghost u_ghost = -u.
+  /// face's control volume, with the wall's ghost u_ghost = 2 U_wall - u.
   std::array<double, 3> wall_shear() const {
     const MacGrid& g = s_.grid;
     std::array<double, 3> F{0, 0, 0};
@@ -441,7 +499,8 @@ class VansSolver {
           if (b == a) continue;
           for (int side = 0; side < 2; ++side) {
             if (idx[b] != (side ? g.fn(a, b) - 1 : 0) || s_.sides[2 * b + side].type != Boundary::wall) continue;
-            F[a] += s_.mu * face_eps(eps_, a, i, j, k) * (-2.0 * u_[a][f]) / (g.h[b] * g.h[b]) * V;
+            const double wall_u = s_.sides[2 * b + side].velocity[a];
+            F[a] += s_.mu * face_eps(eps_, a, i, j, k) * 2.0 * (wall_u - u_[a][f]) / (g.h[b] * g.h[b]) * V;
           }
         }
       });
@@ -501,7 +560,17 @@ class VansSolver {
                 inside = inside && x >= b.patch_lo[d] && x <= b.patch_hi[d];
               }
             kind_[a][f] = inside ? FaceKind::inlet : FaceKind::wall;
-            if (inside) inlet_value_[a][f] = b.velocity[a];
+            if (inside) {
+              double shape = 1;
+              if (b.parabolic)
+                for (int d = 0; d < 3; ++d) {
+                  if (d == a || g.n[d] < 2) continue;
+                  const double lo = b.patch ? b.patch_lo[d] : g.lo[d], hi = b.patch ? b.patch_hi[d] : g.hi(d);
+                  const double sd = hi > lo ? (g.centre(d, idx[d]) - lo) / (hi - lo) : 0.5;
+                  shape *= 4 * sd * (1 - sd);
+                }
+              inlet_value_[a][f] = b.velocity[a] * shape;
+            }
           }
           return;
         }
@@ -561,14 +630,56 @@ class VansSolver {
     if (b == a) return here;  // beyond the last normal face: zero gradient
     const Boundary& bd = s_.sides[2 * b + (dir > 0 ? 1 : 0)];
     switch (bd.type) {
-      case Boundary::wall: return -here;
+      case Boundary::wall: return 2 * bd.velocity[a] - here;
       case Boundary::slip_wall: return here;
       case Boundary::velocity_inlet: return 2 * bd.velocity[a] - here;
       default: return here;
     }
   }
 
+  /// u_a two faces back (out[0]) and ahead (out[1]) along b from face (i,
+  /// j, k) of axis a, for van Leer's stencil: beyond the box, along a the
+  /// last face's (zero gradient), across it the mirror image of the face
+  /// as far inside, by the side's kind as neighbour() takes it. False when
+  /// an obstacle lies within two faces (the caller takes upwind there).
+  bool second_neighbours(int a, int b, int i, int j, int k, double out[2]) const {
+    const MacGrid& g = s_.grid;
+    const int idx[3] = {i, j, k}, n = g.fn(a, b);
+    for (int s = 0; s < 2; ++s) {
+      const int dir = s ? 1 : -1;
+      int q[3] = {i, j, k};
+      if (b != a) {  // an obstacle within two faces: upwind
+        for (int step = 1; step <= 2; ++step) {
+          q[b] = idx[b] + dir * step;
+          if (q[b] >= 0 && q[b] < n && solid_face(a, q[0], q[1], q[2])) return false;
+        }
+      }
+      q[b] = idx[b] + 2 * dir;
+      if (q[b] >= 0 && q[b] < n) {
+        out[s] = u_[a][g.face(a, q[0], q[1], q[2])];
+        continue;
+      }
+      const int inside = std::clamp(q[b], 0, n - 1);
+      if (b == a) {
+        q[b] = inside;
+        out[s] = u_[a][g.face(a, q[0], q[1], q[2])];
+        continue;
+      }
+      q[b] = q[b] < 0 ? -1 - q[b] : 2 * n - 1 - q[b];  // the mirror image
+      const Boundary& bd = s_.sides[2 * b + s];
+      if (bd.type == Boundary::pressure_outlet) q[b] = inside;  // zero gradient
+      const double m = u_[a][g.face(a, q[0], q[1], q[2])];
+      switch (bd.type) {
+        case Boundary::wall: out[s] = 2 * bd.velocity[a] - m; break;
+        case Boundary::velocity_inlet: out[s] = 2 * bd.velocity[a] - m; break;
+        default: out[s] = m;
+      }
+    }
+    return true;
+  }
+
   Settings s_;
+  bool closed_ = false;  ///< no outlet: the pressure correction pinned in the first fluid cell
   std::vector<std::uint8_t> blocked_;
   std::vector<double> eps_, eps_old_, p_;
   std::array<std::vector<double>, 3> u_, K_, Ku_, inlet_value_;

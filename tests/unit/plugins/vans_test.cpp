@@ -160,7 +160,14 @@ TEST(Vans, BadBoundariesAndObstaclesAreRefusedNamingTheKey) {
   EXPECT_NE(refusal(p).find("boundaries/z_min: the velocity inlet has no open face"), std::string::npos) << refusal(p);
   p = base();
   p["boundaries"]["z_max"]["velocity"] = {0, 0, 1};
-  EXPECT_NE(refusal(p).find("boundaries/z_max: 'velocity' and 'patch' belong to a velocity_inlet"), std::string::npos)
+  EXPECT_NE(refusal(p).find("boundaries/z_max: 'velocity' belongs to a velocity_inlet or a (moving) wall, not a "
+                            "pressure_outlet"),
+            std::string::npos)
+      << refusal(p);
+  p = base();
+  p["boundaries"]["x_min"] = {{"type", "wall"}, {"velocity", {0.1, 1, 0}}};  // a lid moves along itself only
+  EXPECT_NE(refusal(p).find("boundaries/x_min: a wall moves only along itself; its velocity along x must be 0"),
+            std::string::npos)
       << refusal(p);
   p = base();
   json speck = {{"min", {0.1, 0.1, 0.1}}, {"max", {0.2, 0.2, 0.2}}};  // outside the grid
@@ -288,4 +295,36 @@ TEST(Vans, TheGasVelocityAtAParticleVanishesOnAnObstacleAndIsTheCellsBesideABoxW
     EXPECT_NEAR(ps.uz[1], u1, 1e-12) << where;
     EXPECT_NEAR(ps.uz[2], obstacle ? 2e-6 * u1 : u1, 1e-12) << where;  // 1e-9 m from it: 2e-9/h of u1
   }
+}
+
+// The options of issue 45 item 1 reach the solver: `advection`, a wall moving
+// along itself, a parabolic inlet. The parabolic inlet over the whole z_min
+// side (4 x 4 cells, centres at s = 1/8, 3/8, 5/8, 7/8) carries U 16 s_x (1 -
+// s_x) s_y (1 - s_y) on each face; its flux is the centre speed times the
+// side's area times the square of the faces' mean of 4 s (1 - s), (0.4375 +
+// 0.9375) / 2 = 0.6875 (no particles: eps = 1).
+TEST(Vans, TheAdvectionSchemeAMovingWallAndAParabolicInletAreTakenFromTheScenario) {
+  json p = base();
+  p["advection"] = "van_leer";
+  p["boundaries"]["x_max"] = {{"type", "wall"}, {"velocity", {0, 0.2, 0}}};
+  p["boundaries"]["z_min"] = {{"type", "velocity_inlet"}, {"velocity", {0, 0, 0.5}}, {"profile", "parabolic"}};
+  Vans v{domel::sdk::Params(p)};
+  const auto& sv = v.solver();
+  EXPECT_EQ(sv.settings().advection, domel::plugins::fluid::Advection::van_leer);
+  EXPECT_EQ(sv.settings().sides[1].velocity[1], 0.2);
+  Particles ps(0);
+  exchange(v, ps, 0, 1e-4);
+  const auto& g = sv.grid();
+  double flux = 0;
+  sv.for_faces(2, [&](int i, int j, int k, std::size_t f) {
+    if (k != 0) return;
+    const double sx = (i + 0.5) / 4, sy = (j + 0.5) / 4;
+    EXPECT_NEAR(sv.u(2)[f], 0.5 * 16 * sx * (1 - sx) * sy * (1 - sy), 1e-15);
+    flux += sv.u(2)[f] * g.h[0] * g.h[1];
+  });
+  EXPECT_NEAR(flux, 0.5 * 0.6875 * 0.6875 * 0.04 * 0.04, 1e-15);
+  p["boundaries"]["x_max"]["velocity"] = {0.1, 0.2, 0};
+  EXPECT_NE(refusal(p).find("boundaries/x_max: a wall moves only along itself; its velocity along x must be 0"),
+            std::string::npos)
+      << refusal(p);
 }
