@@ -158,6 +158,7 @@ class VansSolver {
     unknown_.assign(g.cells(), SIZE_MAX);
     for (std::size_t c = 0; c < g.cells(); ++c)
       if (!blocked_[c]) unknown_[c] = n_unknowns_++;
+    build_stencils();
     // start: the initial velocity on the free faces, the inlet values on inlets
     for (int a = 0; a < 3; ++a)
       for (std::size_t f = 0; f < g.faces(a); ++f)
@@ -262,7 +263,8 @@ class VansSolver {
   /// for sub-steps; eps_old_ is eps at the start of the interval.
   SolveReport step(double dt, double frac_from, double frac_to, const PressureSolver& solve) {
     const MacGrid& g = s_.grid;
-    std::vector<double> e0(g.cells()), e1(g.cells());
+    std::vector<double>& e0 = e0_;
+    std::vector<double>& e1 = e1_;
     for (std::size_t c = 0; c < g.cells(); ++c) {
       e0[c] = eps_old_[c] + frac_from * (eps_[c] - eps_old_[c]);
       e1[c] = eps_old_[c] + frac_to * (eps_[c] - eps_old_[c]);
@@ -270,90 +272,70 @@ class VansSolver {
     // an inlet prescribes the superficial velocity: eps u = U across the face
     // (the gas enters from below a bed as through a distributor)
     for (int a = 0; a < 3; ++a)
-      for_faces(a, [&](int i, int j, int k, std::size_t f) {
-        if (kind_[a][f] == FaceKind::inlet) u_[a][f] = inlet_value_[a][f] / face_eps(e1, a, i, j, k);
-      });
-    // predictor
-    std::array<std::vector<double>, 3> us, A;
+      for (const std::uint32_t f : inlet_faces_[a]) u_[a][f] = inlet_value_[a][f] / face_eps_of(e1, a, f);
+    // predictor, over the free faces
+    auto half_slope = [](double d1, double d2) {  // the limited slope's half: van Leer's harmonic mean
+      const double p = d1 * d2;
+      return p > 0 ? p / (d1 + d2) : 0.0;
+    };
+    const bool van_leer = s_.advection == Advection::van_leer;
     for (int a = 0; a < 3; ++a) {
-      us[a] = u_[a];
-      A[a].assign(g.faces(a), 0.0);
-    }
-    for (int a = 0; a < 3; ++a)
-      for_faces(a, [&](int i, int j, int k, std::size_t f) {
-        const FaceKind kd = kind_[a][f];
-        if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
-        const double ef1 = face_eps(e1, a, i, j, k);
-        const double un = u_[a][f];
+      const std::vector<double>& ua = u_[a];
+      us_[a] = ua;
+      std::fill(A_[a].begin(), A_[a].end(), 0.0);
+      for (const FaceStencil& st : stencil_[a]) {
+        const std::size_t f = st.f;
+        const double ef1 = face_eps_of(e1, a, f);
+        const double un = ua[f];
         // advection (upwind or van Leer) and diffusion of u_a
         double adv = 0, lap = 0;
-        for (int b = 0; b < 3; ++b) {
-          const double ub = (b == a) ? un : cross_velocity(a, b, i, j, k);
-          const double um = neighbour(a, b, -1, i, j, k), up = neighbour(a, b, +1, i, j, k);
-          double u2[2];  // u_a two faces back and ahead along b
-          if (s_.advection == Advection::van_leer && second_neighbours(a, b, i, j, k, u2)) {
-            // the limited slope's half, van Leer's harmonic mean of the two differences
-            auto half_slope = [](double d1, double d2) {
-              const double p = d1 * d2;
-              return p > 0 ? p / (d1 + d2) : 0.0;
-            };
-            const double hi_face = ub > 0 ? un + half_slope(un - um, up - un) : up - half_slope(u2[1] - up, up - un);
-            const double lo_face = ub > 0 ? um + half_slope(um - u2[0], un - um) : un - half_slope(up - un, un - um);
+        for (int b = 0, m = 0; b < 3; ++b) {
+          double ub = un;
+          if (b != a) {  // the mean of the b-faces around this one
+            double sum = 0;
+            for (int q = 0; q < st.n_cross[m]; ++q) sum += u_[b][st.cross[m][q]];
+            ub = st.n_cross[m] ? sum / st.n_cross[m] : 0.0;
+            ++m;
+          }
+          const double um = value(st.near[b][0], ua), up = value(st.near[b][1], ua);
+          if (van_leer && (st.far_ok >> b & 1)) {
+            const double u_mm = value(st.far[b][0], ua), u_pp = value(st.far[b][1], ua);
+            const double hi_face = ub > 0 ? un + half_slope(un - um, up - un) : up - half_slope(u_pp - up, up - un);
+            const double lo_face = ub > 0 ? um + half_slope(um - u_mm, un - um) : un - half_slope(up - un, un - um);
             adv += ub * (hi_face - lo_face) / g.h[b];
           } else {
             adv += ub > 0 ? ub * (un - um) / g.h[b] : ub * (up - un) / g.h[b];
           }
           lap += (up - 2 * un + um) / (g.h[b] * g.h[b]);
         }
-        const double gradp = face_gradient(p_, a, i, j, k, kd);
+        const double gradp = st.outlet ? outlet_gradient(p_, a, f) : (p_[cells_of_[a][f][1]] - p_[cells_of_[a][f][0]]) / g.h[a];
         const double R = -s_.rho * ef1 * adv + s_.mu * ef1 * lap - ef1 * gradp + s_.rho * ef1 * s_.gravity[a];
         const double K = K_[a][f];
-        us[a][f] = (s_.rho * ef1 * un / dt + R + Ku_[a][f]) / (s_.rho * ef1 / dt + K);
-        A[a][f] = ef1 * dt / (s_.rho * ef1 + K * dt);
-      });
-    // pressure system
-    PressureSystem sys;
-    sys.n = g.n;
-    sys.cell_of.assign(n_unknowns_, 0);
-    for (std::size_t c = 0; c < g.cells(); ++c)
-      if (!blocked_[c]) sys.cell_of[unknown_[c]] = c;
-    sys.diag.assign(n_unknowns_, 0.0);
-    sys.off.assign(n_unknowns_, {});
-    sys.rhs.assign(n_unknowns_, 0.0);
-    for (int k = 0; k < g.n[2]; ++k)
-      for (int j = 0; j < g.n[1]; ++j)
-        for (int i = 0; i < g.n[0]; ++i) {
-          const std::size_t c = g.cell(i, j, k);
-          if (blocked_[c]) continue;
-          const std::size_t P = unknown_[c];
-          double div = 0;
-          for (int a = 0; a < 3; ++a) {
-            for (int s = 0; s < 2; ++s) {  // s = 0: the face on the low side, 1: the high side
-              int fi[3] = {i, j, k};
-              fi[a] += s;
-              const std::size_t f = g.face(a, fi[0], fi[1], fi[2]);
-              const double ef = face_eps(e1, a, fi[0], fi[1], fi[2]);
-              div += (s ? 1.0 : -1.0) * ef * us[a][f] / g.h[a];
-              const FaceKind kd = kind_[a][f];
-              if (kd == FaceKind::interior) {
-                int ni[3] = {i, j, k};
-                ni[a] += s ? 1 : -1;
-                const double coef = ef * A[a][f] / (g.h[a] * g.h[a]);
-                sys.diag[P] += coef;
-                sys.off[P].push_back({unknown_[g.cell(ni[0], ni[1], ni[2])], -coef});
-              } else if (kd == FaceKind::outlet) {
-                sys.diag[P] += ef * A[a][f] / (g.h[a] * 0.5 * g.h[a]);
-              }
-            }
-          }
-          sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
-        }
-    if (closed_) {  // p' = 0 in the first fluid cell: its row and column leave the system
-      sys.off[0].clear();
-      sys.rhs[0] = 0;
-      for (auto& row : sys.off)
-        row.erase(std::remove_if(row.begin(), row.end(), [](const auto& e) { return e.first == 0; }), row.end());
+        us_[a][f] = (s_.rho * ef1 * un / dt + R + Ku_[a][f]) / (s_.rho * ef1 / dt + K);
+        A_[a][f] = ef1 * dt / (s_.rho * ef1 + K * dt);
+      }
     }
+    // pressure system: its pattern is the constructor's, its values this step's
+    PressureSystem& sys = sys_;
+    for (std::size_t P = 0; P < n_unknowns_; ++P) {
+      double div = 0, diag = 0;
+      for (const CellFace& cf : cell_faces_[P]) {
+        const int a = cf.axis;
+        const double ef = face_eps_of(e1, a, cf.f);
+        div += (cf.high ? 1.0 : -1.0) * ef * us_[a][cf.f] / g.h[a];
+        if (cf.kind == FaceKind::interior) {
+          const double coef = ef * A_[a][cf.f] / (g.h[a] * g.h[a]);
+          diag += coef;
+          if (cf.slot >= 0) sys.off[P][static_cast<std::size_t>(cf.slot)].second = -coef;
+        } else if (cf.kind == FaceKind::outlet) {
+          diag += ef * A_[a][cf.f] / (g.h[a] * 0.5 * g.h[a]);
+        }
+      }
+      const std::size_t c = sys.cell_of[P];
+      sys.diag[P] = diag;
+      sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
+    }
+    if (closed_) sys.rhs[0] = 0;  // p' = 0 in the first fluid cell (its row and column left out)
     {
       // the flow's own rate of strain (or 1 mm/s over a cell at rest), over
       // the whole system: the solve stops at the tolerance times this, so a
@@ -366,28 +348,23 @@ class VansSolver {
       }
       sys.reference_norm = std::sqrt(static_cast<double>(n_unknowns_)) * (rate + 1e-3 / hmin);
     }
-    std::vector<double> pc(n_unknowns_, 0.0);
+    std::vector<double>& pc = pc_;
+    std::fill(pc.begin(), pc.end(), 0.0);
     const SolveReport rep = solve(sys, pc);
-    // correction
-    auto pcorr = [&](int i, int j, int k) { return pc[unknown_[g.cell(i, j, k)]]; };
+    // correction, over the free faces
     for (int a = 0; a < 3; ++a)
-      for_faces(a, [&](int i, int j, int k, std::size_t f) {
-        const FaceKind kd = kind_[a][f];
-        if (kd == FaceKind::interior) {
-          int l[3] = {i, j, k};
-          l[a] -= 1;
-          u_[a][f] = us[a][f] - A[a][f] * (pcorr(i, j, k) - pcorr(l[0], l[1], l[2])) / g.h[a];
-        } else if (kd == FaceKind::outlet) {
-          const int idx[3] = {i, j, k};
-          if (idx[a] == 0)  // low side: the cell is (i, j, k); p' = 0 outside
-            u_[a][f] = us[a][f] - A[a][f] * (pcorr(i, j, k) - 0.0) / (0.5 * g.h[a]);
-          else {
-            int l[3] = {i, j, k};
-            l[a] -= 1;
-            u_[a][f] = us[a][f] - A[a][f] * (0.0 - pcorr(l[0], l[1], l[2])) / (0.5 * g.h[a]);
-          }
+      for (const FaceStencil& st : stencil_[a]) {
+        const std::size_t f = st.f;
+        const std::size_t lo = cells_of_[a][f][0], hi = cells_of_[a][f][1];
+        if (!st.outlet) {
+          u_[a][f] = us_[a][f] - A_[a][f] * (pc[unknown_[hi]] - pc[unknown_[lo]]) / g.h[a];
+        } else {  // p' = 0 beyond the outlet, half a cell from the cell's centre
+          if (st.outlet_low)
+            u_[a][f] = us_[a][f] - A_[a][f] * (pc[unknown_[hi]] - 0.0) / (0.5 * g.h[a]);
+          else
+            u_[a][f] = us_[a][f] - A_[a][f] * (0.0 - pc[unknown_[lo]]) / (0.5 * g.h[a]);
         }
-      });
+      }
     for (std::size_t c = 0; c < g.cells(); ++c)
       if (!blocked_[c]) p_[c] += pc[unknown_[c]];
     return rep;
@@ -595,54 +572,75 @@ class VansSolver {
     return (p[g.cell(i, j, k)] - p[g.cell(l[0], l[1], l[2])]) / g.h[a];
   }
 
-  /// The velocity component b at face (i, j, k) of axis a (b != a): the mean
-  /// of the (up to) four b-faces around it.
-  double cross_velocity(int a, int b, int i, int j, int k) const {
-    const MacGrid& g = s_.grid;
-    double sum = 0;
-    int cnt = 0;
-    for (int da = -1; da <= 0; ++da)
-      for (int db = 0; db <= 1; ++db) {
-        int q[3] = {i, j, k};
-        q[a] += da;
-        q[b] += db;
-        if (q[a] < 0 || q[a] >= g.fn(b, a)) continue;
-        sum += u_[b][g.face(b, q[0], q[1], q[2])];
-        ++cnt;
-      }
-    return cnt ? sum / cnt : 0.0;
+  /// u_a at a face near another, as (-)u_a[idx] + offsets_[offset]: a
+  /// neighbour inside the box, or a boundary's ghost value (a wall's or an
+  /// inlet's 2 U - u mirrored, a slip wall's u, an outlet's copy).
+  struct Rule {
+    std::uint32_t idx = 0;
+    bool negate = false;
+    std::uint8_t offset = 0;  ///< into offsets_, whose entry 0 is 0
+  };
+  double value(const Rule& r, const std::vector<double>& u) const {
+    return (r.negate ? -u[r.idx] : u[r.idx]) + offsets_[r.offset];
   }
 
-  /// u_a at the face one step along b (dir -1 or +1) from face (i, j, k) of
-  /// axis a, with the boundary's ghost value beyond the box: a wall mirrors
-  /// the tangential velocity (no slip), an inlet sets it, an outlet copies it.
-  double neighbour(int a, int b, int dir, int i, int j, int k) const {
+  /// What the predictor reads around a free face of axis a, built once.
+  struct FaceStencil {
+    std::uint32_t f = 0;
+    Rule near[3][2];                    ///< u_a one face back and ahead along b
+    Rule far[3][2];                     ///< two faces back and ahead (van Leer's stencil), where far_ok has bit b
+    std::uint32_t cross[2][4] = {};     ///< the b-faces whose mean is u_b here, for the two b != a in order
+    std::uint8_t n_cross[2] = {0, 0};
+    std::uint8_t far_ok = 0;
+    bool outlet = false, outlet_low = false;  ///< an outlet face, on the box's low side
+  };
+  /// One of a fluid cell's six faces, for the pressure system.
+  struct CellFace {
+    std::uint32_t f = 0;
+    std::uint8_t axis = 0;
+    bool high = false;                     ///< the face on the cell's high side along axis
+    FaceKind kind = FaceKind::wall;
+    std::int32_t slot = -1;                ///< its entry in the row's off-diagonals (interior faces; -1: none)
+  };
+
+  /// The offset's index in offsets_, appended if new.
+  std::uint8_t offset_code(double v) {
+    for (std::size_t q = 0; q < offsets_.size(); ++q)
+      if (offsets_[q] == v) return static_cast<std::uint8_t>(q);
+    offsets_.push_back(v);
+    return static_cast<std::uint8_t>(offsets_.size() - 1);
+  }
+
+  /// The rule for u_a at the face one step along b (dir -1 or +1) from face
+  /// (i, j, k) of axis a, with the boundary's ghost value beyond the box: a
+  /// wall mirrors the tangential velocity about its own (no slip), an inlet
+  /// about its velocity, a slip wall and an outlet copy it.
+  Rule neighbour_rule(int a, int b, int dir, int i, int j, int k) {
     const MacGrid& g = s_.grid;
     int q[3] = {i, j, k};
     q[b] += dir;
-    const double here = u_[a][g.face(a, i, j, k)];
+    const auto here = static_cast<std::uint32_t>(g.face(a, i, j, k));
     if (q[b] >= 0 && q[b] < g.fn(a, b)) {
       // a tangential face inside an obstacle: mirrored, so the no-slip wall
       // lies on the obstacle's face, half a cell from either node
-      if (b != a && solid_face(a, q[0], q[1], q[2])) return -here;
-      return u_[a][g.face(a, q[0], q[1], q[2])];
+      if (b != a && solid_face(a, q[0], q[1], q[2])) return {here, true, 0};
+      return {static_cast<std::uint32_t>(g.face(a, q[0], q[1], q[2])), false, 0};
     }
-    if (b == a) return here;  // beyond the last normal face: zero gradient
+    if (b == a) return {here, false, 0};  // beyond the last normal face: zero gradient
     const Boundary& bd = s_.sides[2 * b + (dir > 0 ? 1 : 0)];
     switch (bd.type) {
-      case Boundary::wall: return 2 * bd.velocity[a] - here;
-      case Boundary::slip_wall: return here;
-      case Boundary::velocity_inlet: return 2 * bd.velocity[a] - here;
-      default: return here;
+      case Boundary::wall:
+      case Boundary::velocity_inlet: return {here, true, offset_code(2 * bd.velocity[a])};
+      default: return {here, false, 0};
     }
   }
 
-  /// u_a two faces back (out[0]) and ahead (out[1]) along b from face (i,
-  /// j, k) of axis a, for van Leer's stencil: beyond the box, along a the
-  /// last face's (zero gradient), across it the mirror image of the face
-  /// as far inside, by the side's kind as neighbour() takes it. False when
-  /// an obstacle lies within two faces (the caller takes upwind there).
-  bool second_neighbours(int a, int b, int i, int j, int k, double out[2]) const {
+  /// The rules for u_a two faces back (out[0]) and ahead (out[1]) along b
+  /// from face (i, j, k) of axis a, for van Leer's stencil: beyond the box,
+  /// along a the last face's (zero gradient), across it the mirror image of
+  /// the face as far inside, by the side's kind as neighbour_rule() takes it.
+  /// False when an obstacle lies within two faces (upwind there).
+  bool far_rules(int a, int b, int i, int j, int k, Rule out[2]) {
     const MacGrid& g = s_.grid;
     const int idx[3] = {i, j, k}, n = g.fn(a, b);
     for (int s = 0; s < 2; ++s) {
@@ -656,26 +654,124 @@ class VansSolver {
       }
       q[b] = idx[b] + 2 * dir;
       if (q[b] >= 0 && q[b] < n) {
-        out[s] = u_[a][g.face(a, q[0], q[1], q[2])];
+        out[s] = {static_cast<std::uint32_t>(g.face(a, q[0], q[1], q[2])), false, 0};
         continue;
       }
       const int inside = std::clamp(q[b], 0, n - 1);
       if (b == a) {
         q[b] = inside;
-        out[s] = u_[a][g.face(a, q[0], q[1], q[2])];
+        out[s] = {static_cast<std::uint32_t>(g.face(a, q[0], q[1], q[2])), false, 0};
         continue;
       }
-      q[b] = q[b] < 0 ? -1 - q[b] : 2 * n - 1 - q[b];  // the mirror image
+      // the mirror image (on an axis of one cell, the face itself)
+      q[b] = std::clamp(q[b] < 0 ? -1 - q[b] : 2 * n - 1 - q[b], 0, n - 1);
       const Boundary& bd = s_.sides[2 * b + s];
       if (bd.type == Boundary::pressure_outlet) q[b] = inside;  // zero gradient
-      const double m = u_[a][g.face(a, q[0], q[1], q[2])];
-      switch (bd.type) {
-        case Boundary::wall: out[s] = 2 * bd.velocity[a] - m; break;
-        case Boundary::velocity_inlet: out[s] = 2 * bd.velocity[a] - m; break;
-        default: out[s] = m;
-      }
+      const auto m = static_cast<std::uint32_t>(g.face(a, q[0], q[1], q[2]));
+      if (bd.type == Boundary::wall || bd.type == Boundary::velocity_inlet)
+        out[s] = {m, true, offset_code(2 * bd.velocity[a])};
+      else
+        out[s] = {m, false, 0};
     }
     return true;
+  }
+
+  /// The stencils (FaceStencil per free face), the cells beside every face,
+  /// the inlet faces, and the pressure system's pattern (CellFace per fluid
+  /// cell; the off-diagonals in the order the faces are visited, none to or
+  /// from a closed box's pinned first cell).
+  void build_stencils() {
+    const MacGrid& g = s_.grid;
+    offsets_.assign(1, 0.0);
+    for (int a = 0; a < 3; ++a) {
+      cells_of_[a].resize(g.faces(a));
+      inlet_faces_[a].clear();
+      stencil_[a].clear();
+      us_[a].assign(g.faces(a), 0.0);
+      A_[a].assign(g.faces(a), 0.0);
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        const int idx[3] = {i, j, k};
+        int l[3] = {i, j, k};
+        l[a] -= 1;
+        const auto lo = static_cast<std::uint32_t>(idx[a] == 0 ? g.cell(i, j, k) : g.cell(l[0], l[1], l[2]));
+        const auto hi = static_cast<std::uint32_t>(idx[a] == g.n[a] ? g.cell(l[0], l[1], l[2]) : g.cell(i, j, k));
+        cells_of_[a][f] = {lo, hi};
+        const FaceKind kd = kind_[a][f];
+        if (kd == FaceKind::inlet) inlet_faces_[a].push_back(static_cast<std::uint32_t>(f));
+        if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
+        FaceStencil st;
+        st.f = static_cast<std::uint32_t>(f);
+        st.outlet = kd == FaceKind::outlet;
+        st.outlet_low = st.outlet && idx[a] == 0;
+        for (int b = 0, m = 0; b < 3; ++b) {
+          st.near[b][0] = neighbour_rule(a, b, -1, i, j, k);
+          st.near[b][1] = neighbour_rule(a, b, +1, i, j, k);
+          if (far_rules(a, b, i, j, k, st.far[b])) st.far_ok |= static_cast<std::uint8_t>(1u << b);
+          if (b == a) continue;
+          // u_b here: the mean of the (up to) four b-faces around the face
+          for (int da = -1; da <= 0; ++da)
+            for (int db = 0; db <= 1; ++db) {
+              int q[3] = {i, j, k};
+              q[a] += da;
+              q[b] += db;
+              if (q[a] < 0 || q[a] >= g.fn(b, a)) continue;
+              st.cross[m][st.n_cross[m]++] = static_cast<std::uint32_t>(g.face(b, q[0], q[1], q[2]));
+            }
+          ++m;
+        }
+        stencil_[a].push_back(st);
+      });
+    }
+    e0_.assign(g.cells(), 0.0);
+    e1_.assign(g.cells(), 0.0);
+    pc_.assign(n_unknowns_, 0.0);
+    sys_ = PressureSystem{};
+    sys_.n = g.n;
+    sys_.cell_of.assign(n_unknowns_, 0);
+    sys_.diag.assign(n_unknowns_, 0.0);
+    sys_.off.assign(n_unknowns_, {});
+    sys_.rhs.assign(n_unknowns_, 0.0);
+    cell_faces_.assign(n_unknowns_, {});
+    for (int k = 0; k < g.n[2]; ++k)
+      for (int j = 0; j < g.n[1]; ++j)
+        for (int i = 0; i < g.n[0]; ++i) {
+          const std::size_t c = g.cell(i, j, k);
+          if (blocked_[c]) continue;
+          const std::size_t P = unknown_[c];
+          sys_.cell_of[P] = c;
+          int slot = 0;
+          for (int a = 0; a < 3; ++a)
+            for (int s = 0; s < 2; ++s) {  // s = 0: the face on the low side, 1: the high side
+              int fi[3] = {i, j, k};
+              fi[a] += s;
+              CellFace& cf = cell_faces_[P][2 * a + s];
+              cf.f = static_cast<std::uint32_t>(g.face(a, fi[0], fi[1], fi[2]));
+              cf.axis = static_cast<std::uint8_t>(a);
+              cf.high = s == 1;
+              cf.kind = kind_[a][cf.f];
+              if (cf.kind != FaceKind::interior) continue;
+              int ni[3] = {i, j, k};
+              ni[a] += s ? 1 : -1;
+              const std::size_t nb = unknown_[g.cell(ni[0], ni[1], ni[2])];
+              if (closed_ && (P == 0 || nb == 0)) continue;  // the pinned cell's row and column
+              cf.slot = slot++;
+              sys_.off[P].push_back({nb, 0.0});
+            }
+        }
+  }
+
+  /// eps on face f of axis a: the mean of the cells on its two sides, the
+  /// inner cell's on the box's boundary (face_eps()).
+  double face_eps_of(const std::vector<double>& e, int a, std::size_t f) const {
+    return 0.5 * (e[cells_of_[a][f][0]] + e[cells_of_[a][f][1]]);
+  }
+
+  /// The pressure gradient on outlet face f of axis a (face_gradient()).
+  double outlet_gradient(const std::vector<double>& p, int a, std::size_t f) const {
+    const MacGrid& g = s_.grid;
+    const std::size_t n0 = static_cast<std::size_t>(g.fn(a, 0)), n1 = static_cast<std::size_t>(g.fn(a, 1));
+    return face_gradient(p, a, static_cast<int>(f % n0), static_cast<int>((f / n0) % n1), static_cast<int>(f / (n0 * n1)),
+                         FaceKind::outlet);
   }
 
   Settings s_;
@@ -686,6 +782,16 @@ class VansSolver {
   std::array<std::vector<FaceKind>, 3> kind_;
   std::vector<std::size_t> unknown_;
   std::size_t n_unknowns_ = 0;
+  // built once by build_stencils()
+  std::vector<double> offsets_{0.0};
+  std::array<std::vector<FaceStencil>, 3> stencil_;
+  std::array<std::vector<std::array<std::uint32_t, 2>>, 3> cells_of_;  ///< per face: the cells below and above along a
+  std::array<std::vector<std::uint32_t>, 3> inlet_faces_;
+  std::vector<std::array<CellFace, 6>> cell_faces_;  ///< per unknown
+  // the step's work arrays, kept between steps
+  std::vector<double> e0_, e1_, pc_;
+  std::array<std::vector<double>, 3> us_, A_;
+  PressureSystem sys_;
 };
 
 }  // namespace domel::plugins::fluid
