@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 namespace domel::plugins::fluid {
@@ -53,6 +54,9 @@ struct PressurePfmg::State {
   HYPRE_StructGrid grid = nullptr;
   HYPRE_StructStencil stencil = nullptr;
   std::vector<double> values, rhs, sol;
+  std::vector<char> fluid;                  ///< per cell: an unknown of the system
+  std::vector<std::size_t> pattern;         ///< the off-diagonals' columns, row after row, as last seen
+  std::vector<std::uint8_t> entry;          ///< each one's stencil entry (1-6)
   bool restored = false;  ///< sol came from a checkpoint: the first solve keeps it
   ~State() {
     if (stencil) HYPRE_StructStencilDestroy(stencil);
@@ -91,33 +95,58 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     if (!s.restored || s.sol.size() != cells) s.sol.assign(cells, 0.0);
     s.restored = false;
   }
+  // the stencil entry of each off-diagonal, found again only when the
+  // system's pattern changes (the coupler's stays the same from step to step)
+  bool same = true;
+  {
+    std::size_t q = 0;
+    for (std::size_t r = 0; r < sys.diag.size() && same; ++r)
+      for (const auto& [col, v] : sys.off[r]) {
+        if (q >= s.pattern.size() || s.pattern[q] != col) {
+          same = false;
+          break;
+        }
+        ++q;
+      }
+    same = same && q == s.pattern.size() && s.fluid.size() == cells;
+  }
+  const auto nx = static_cast<std::size_t>(sys.n[0]), nxy = nx * static_cast<std::size_t>(sys.n[1]);
+  if (!same) {
+    s.pattern.clear();
+    s.entry.clear();
+    s.fluid.assign(cells, 0);
+    for (std::size_t r = 0; r < sys.diag.size(); ++r) {
+      const std::size_t c = sys.cell_of[r];
+      s.fluid[c] = 1;
+      const long ci = static_cast<long>(c % nx), cj = static_cast<long>((c / nx) % sys.n[1]),
+                 ck = static_cast<long>(c / nxy);
+      for (const auto& [col, v] : sys.off[r]) {
+        const std::size_t d = sys.cell_of[col];
+        const long di = static_cast<long>(d % nx) - ci, dj = static_cast<long>((d / nx) % sys.n[1]) - cj,
+                   dk = static_cast<long>(d / nxy) - ck;
+        int e = 0;
+        if (di == -1 && dj == 0 && dk == 0) e = 1;
+        else if (di == 1 && dj == 0 && dk == 0) e = 2;
+        else if (di == 0 && dj == -1 && dk == 0) e = 3;
+        else if (di == 0 && dj == 1 && dk == 0) e = 4;
+        else if (di == 0 && dj == 0 && dk == -1) e = 5;
+        else if (di == 0 && dj == 0 && dk == 1) e = 6;
+        else throw std::logic_error("pressure system: a coupling that is not a grid neighbour");
+        s.pattern.push_back(col);
+        s.entry.push_back(static_cast<std::uint8_t>(e));
+      }
+    }
+  }
   // the 7-point rows on the whole grid: identity rows for blocked cells
   s.values.assign(7 * cells, 0.0);
   s.rhs.assign(cells, 0.0);
   for (std::size_t c = 0; c < cells; ++c) s.values[7 * c] = 1.0;
-  std::vector<char> fluid(cells, 0);
-  const auto nx = static_cast<std::size_t>(sys.n[0]), nxy = nx * static_cast<std::size_t>(sys.n[1]);
-  for (std::size_t r = 0; r < sys.diag.size(); ++r) {
+  const std::vector<char>& fluid = s.fluid;
+  for (std::size_t r = 0, q = 0; r < sys.diag.size(); ++r) {
     const std::size_t c = sys.cell_of[r];
-    fluid[c] = 1;
     s.values[7 * c] = sys.diag[r];
     s.rhs[c] = sys.rhs[r];
-    const long ci = static_cast<long>(c % nx), cj = static_cast<long>((c / nx) % sys.n[1]),
-               ck = static_cast<long>(c / nxy);
-    for (const auto& [col, v] : sys.off[r]) {
-      const std::size_t d = sys.cell_of[col];
-      const long di = static_cast<long>(d % nx) - ci, dj = static_cast<long>((d / nx) % sys.n[1]) - cj,
-                 dk = static_cast<long>(d / nxy) - ck;
-      int e = 0;
-      if (di == -1 && dj == 0 && dk == 0) e = 1;
-      else if (di == 1 && dj == 0 && dk == 0) e = 2;
-      else if (di == 0 && dj == -1 && dk == 0) e = 3;
-      else if (di == 0 && dj == 1 && dk == 0) e = 4;
-      else if (di == 0 && dj == 0 && dk == -1) e = 5;
-      else if (di == 0 && dj == 0 && dk == 1) e = 6;
-      else throw std::logic_error("pressure system: a coupling that is not a grid neighbour");
-      s.values[7 * c + e] = v;
-    }
+    for (const auto& [col, v] : sys.off[r]) s.values[7 * c + s.entry[q++]] = v;
   }
   const double bn = sys.rhs_norm();
   x.assign(sys.diag.size(), 0.0);

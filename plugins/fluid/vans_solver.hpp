@@ -351,20 +351,20 @@ class VansSolver {
     std::vector<double>& pc = pc_;
     std::fill(pc.begin(), pc.end(), 0.0);
     const SolveReport rep = solve(sys, pc);
-    // correction, over the free faces
-    for (int a = 0; a < 3; ++a)
-      for (const FaceStencil& st : stencil_[a]) {
-        const std::size_t f = st.f;
+    // correction, over the free faces: the interior ones, then the outlets
+    for (int a = 0; a < 3; ++a) {
+      for (const std::uint32_t f : interior_faces_[a]) {
         const std::size_t lo = cells_of_[a][f][0], hi = cells_of_[a][f][1];
-        if (!st.outlet) {
-          u_[a][f] = us_[a][f] - A_[a][f] * (pc[unknown_[hi]] - pc[unknown_[lo]]) / g.h[a];
-        } else {  // p' = 0 beyond the outlet, half a cell from the cell's centre
-          if (st.outlet_low)
-            u_[a][f] = us_[a][f] - A_[a][f] * (pc[unknown_[hi]] - 0.0) / (0.5 * g.h[a]);
-          else
-            u_[a][f] = us_[a][f] - A_[a][f] * (0.0 - pc[unknown_[lo]]) / (0.5 * g.h[a]);
-        }
+        u_[a][f] = us_[a][f] - A_[a][f] * (pc[unknown_[hi]] - pc[unknown_[lo]]) / g.h[a];
       }
+      for (const auto& [f, low] : outlet_faces_[a]) {  // p' = 0 beyond the outlet, half a cell from the cell's centre
+        const std::size_t c = cells_of_[a][f][0];
+        if (low)
+          u_[a][f] = us_[a][f] - A_[a][f] * (pc[unknown_[c]] - 0.0) / (0.5 * g.h[a]);
+        else
+          u_[a][f] = us_[a][f] - A_[a][f] * (0.0 - pc[unknown_[c]]) / (0.5 * g.h[a]);
+      }
+    }
     for (std::size_t c = 0; c < g.cells(); ++c)
       if (!blocked_[c]) p_[c] += pc[unknown_[c]];
     return rep;
@@ -592,7 +592,7 @@ class VansSolver {
     std::uint32_t cross[2][4] = {};     ///< the b-faces whose mean is u_b here, for the two b != a in order
     std::uint8_t n_cross[2] = {0, 0};
     std::uint8_t far_ok = 0;
-    bool outlet = false, outlet_low = false;  ///< an outlet face, on the box's low side
+    bool outlet = false;
   };
   /// One of a fluid cell's six faces, for the pressure system.
   struct CellFace {
@@ -686,6 +686,8 @@ class VansSolver {
     for (int a = 0; a < 3; ++a) {
       cells_of_[a].resize(g.faces(a));
       inlet_faces_[a].clear();
+      interior_faces_[a].clear();
+      outlet_faces_[a].clear();
       stencil_[a].clear();
       us_[a].assign(g.faces(a), 0.0);
       A_[a].assign(g.faces(a), 0.0);
@@ -698,11 +700,12 @@ class VansSolver {
         cells_of_[a][f] = {lo, hi};
         const FaceKind kd = kind_[a][f];
         if (kd == FaceKind::inlet) inlet_faces_[a].push_back(static_cast<std::uint32_t>(f));
+        if (kd == FaceKind::interior) interior_faces_[a].push_back(static_cast<std::uint32_t>(f));
+        if (kd == FaceKind::outlet) outlet_faces_[a].push_back({static_cast<std::uint32_t>(f), idx[a] == 0});
         if (kd != FaceKind::interior && kd != FaceKind::outlet) return;
         FaceStencil st;
         st.f = static_cast<std::uint32_t>(f);
         st.outlet = kd == FaceKind::outlet;
-        st.outlet_low = st.outlet && idx[a] == 0;
         for (int b = 0, m = 0; b < 3; ++b) {
           st.near[b][0] = neighbour_rule(a, b, -1, i, j, k);
           st.near[b][1] = neighbour_rule(a, b, +1, i, j, k);
@@ -786,7 +789,8 @@ class VansSolver {
   std::vector<double> offsets_{0.0};
   std::array<std::vector<FaceStencil>, 3> stencil_;
   std::array<std::vector<std::array<std::uint32_t, 2>>, 3> cells_of_;  ///< per face: the cells below and above along a
-  std::array<std::vector<std::uint32_t>, 3> inlet_faces_;
+  std::array<std::vector<std::uint32_t>, 3> inlet_faces_, interior_faces_;
+  std::array<std::vector<std::pair<std::uint32_t, bool>>, 3> outlet_faces_;  ///< with: on the box's low side
   std::vector<std::array<CellFace, 6>> cell_faces_;  ///< per unknown
   // the step's work arrays, kept between steps
   std::vector<double> e0_, e1_, pc_;
