@@ -21,6 +21,9 @@ namespace domel::plugins::fluid {
 class PressureCg {
  public:
   PressureCg(double tolerance, int max_iterations) : tol_(tolerance), max_(max_iterations) {}
+  // the solver keeps a reference to A_ once it has factored it: not copied or moved
+  PressureCg(const PressureCg&) = delete;
+  PressureCg& operator=(const PressureCg&) = delete;
 
   SolveReport operator()(const PressureSystem& sys, std::vector<double>& x) {
     const Eigen::Index n = static_cast<Eigen::Index>(sys.diag.size());

@@ -56,6 +56,7 @@ struct PressurePfmg::State {
   std::vector<double> values, rhs, sol;
   std::vector<char> fluid;                  ///< per cell: an unknown of the system
   std::vector<std::size_t> pattern;         ///< the off-diagonals' columns, row after row, as last seen
+  std::vector<std::size_t> cell_of;         ///< the unknowns' cells, as last seen
   std::vector<std::uint8_t> entry;          ///< each one's stencil entry (1-6)
   bool restored = false;  ///< sol came from a checkpoint: the first solve keeps it
   ~State() {
@@ -92,6 +93,8 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     HYPRE_StructStencilCreate(3, 7, &s.stencil);
     for (int e = 0; e < 7; ++e) HYPRE_StructStencilSetElement(s.stencil, e, offsets[e]);
     s.n = sys.n;
+    s.pattern.clear();  // the stencil entries belong to the old grid
+    s.fluid.clear();
     if (!s.restored || s.sol.size() != cells) s.sol.assign(cells, 0.0);
     s.restored = false;
   }
@@ -108,12 +111,13 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
         }
         ++q;
       }
-    same = same && q == s.pattern.size() && s.fluid.size() == cells;
+    same = same && q == s.pattern.size() && s.fluid.size() == cells && s.cell_of == sys.cell_of;
   }
   const auto nx = static_cast<std::size_t>(sys.n[0]), nxy = nx * static_cast<std::size_t>(sys.n[1]);
   if (!same) {
     s.pattern.clear();
     s.entry.clear();
+    s.cell_of = sys.cell_of;
     s.fluid.assign(cells, 0);
     for (std::size_t r = 0; r < sys.diag.size(); ++r) {
       const std::size_t c = sys.cell_of[r];

@@ -34,7 +34,9 @@
 // u_{-1}) / (u_1 - u_0): second order where the profile is smooth, first
 // order at extrema, no new extrema (TVD). Its 5-point stencil takes the
 // boundaries' ghost values two faces out (mirrored), and falls back to
-// upwind beside an obstacle. docs/validation/gas-solver.md checks both.
+// upwind across the flow within two faces of an obstacle (along it, the
+// obstacle's own faces carry the wall's zero normal velocity).
+// docs/validation/gas-solver.md checks both.
 //
 // Boundaries, per side of the box: no-slip wall (normal velocity 0, the
 // tangential one mirrored about the wall's own tangential velocity, zero
@@ -250,11 +252,14 @@ class VansSolver {
   /// Remember the current void fraction as eps^n before a new deposit.
   void keep_old_void_fraction() { eps_old_ = eps_; }
 
-  /// Largest |u_a| over the free and inlet faces, per axis.
+  /// Largest |u_a| over the faces and the moving walls, per axis.
   std::array<double, 3> max_speed() const {
     std::array<double, 3> m{0, 0, 0};
-    for (int a = 0; a < 3; ++a)
+    for (int a = 0; a < 3; ++a) {
       for (double v : u_[a]) m[a] = std::max(m[a], std::abs(v));
+      for (const Boundary& b : s_.sides)
+        if (b.type == Boundary::wall) m[a] = std::max(m[a], std::abs(b.velocity[a]));
+    }
     return m;
   }
 
@@ -335,7 +340,7 @@ class VansSolver {
       sys.diag[P] = diag;
       sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
     }
-    if (closed_) sys.rhs[0] = 0;  // p' = 0 in the first fluid cell (its row and column left out)
+    if (closed_ && n_unknowns_ > 0) sys.rhs[0] = 0;  // p' = 0 in the first fluid cell (its row and column left out)
     {
       // the flow's own rate of strain (or 1 mm/s over a cell at rest), over
       // the whole system: the solve stops at the tolerance times this, so a
