@@ -355,11 +355,20 @@ std::size_t Coupling::insert_face(int face, double t, ParticleStore& s, const st
   double rmax = 0;
   for (double r : fb.queue) rmax = std::max(rmax, r);
   for (double r : s.radius) rmax = std::max(rmax, r);
-  // A uniform hash of the fine particles near the shell (cell edge 2 r_max):
-  // a candidate overlaps only particles in its own and the 26 cells around.
-  const double h = 2 * rmax;
+  // A uniform hash of the fine particles near the shell (cell edge at least
+  // 2 r_max): a candidate overlaps only particles in its own and the 26 cells
+  // around. Its cells grow until there are at most 4e6 of them, counted as
+  // doubles (a region 1e6 m long asked for 3e9 cells of 4 mm, found by the
+  // run-time fuzzer).
+  double h = 2 * rmax;
   int n[3];
   double o[3];
+  for (;;) {
+    double count = 1;
+    for (int a = 0; a < 3; ++a) count *= std::max(1.0, std::ceil((hi[a] - lo[a] + 2 * h) / h));
+    if (count <= 4.0e6) break;
+    h *= std::max(1.25, std::cbrt(count / 2.0e6));
+  }
   for (int a = 0; a < 3; ++a) {
     o[a] = lo[a] - h;
     n[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a] + 2 * h) / h)));

@@ -216,6 +216,33 @@ TEST(Coupling, TheInflowPlacesNothingOverlappingAMeshWall) {
   EXPECT_EQ(top.inserted, fine_mass_units(f));
 }
 
+// A region far longer than the level it couples (1e6 m along x, found by the
+// run-time fuzzer, docs/reliability.md): the inflow's hash of the fine
+// particles sized its 4 mm cells by the region's extent and asked for 2.5e8 x
+// 17 x 5 of them (an allocation of 870 GB under the sanitizers). Its cells now
+// grow until there are at most 4e6; the five parcels' fine particles are
+// placed as in a region of the level's own size. Cost: 0.1 s.
+TEST(Coupling, TheInflowOfARegionFarLongerThanItsLevelPlacesItsParticles) {
+  json doc = two_level();
+  doc["couplings"][0]["region"]["max"] = {1e6, 0.06, 0.03};
+  Levels s = make(doc);
+  auto& c = s.coarse();
+  const auto moved = above(c, 5);
+  ASSERT_EQ(moved.size(), 5u);
+  for (std::size_t q : moved) {
+    c.z[q] = 0.025;
+    c.vz[q] = -0.5;
+  }
+  s.exchange(1e-3);
+  const dp::FaceBalance& top = s.c->faces()[5];
+  auto& f = s.fine();
+  std::printf("[inflow, region 1e6 m long] %zu fine particles placed, %zu waiting\n", f.size(), top.queue.size());
+  EXPECT_EQ(top.parcels, 5u);
+  EXPECT_GT(f.size(), 10u);
+  EXPECT_EQ(top.n_inserted + top.queue.size(), 40u);
+  EXPECT_EQ(top.inserted, fine_mass_units(f));
+}
+
 TEST(Coupling, EachInflowFaceCountsAParcelOnce) {
   json doc = two_level();
   doc["couplings"][0]["inflow_faces"] = {"+z", "-z"};
