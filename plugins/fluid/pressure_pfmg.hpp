@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The multigrid pressure solve of the built-in fluid coupler: hypre's
 // structured-grid conjugate gradient preconditioned by one V-cycle of PFMG
-// (Ashby & Falgout 1996; hypre's Struct interface), on the 7-point system of
+// (Ashby & Falgout 1996; hypre's Struct interface), the V-cycle's levels kept
+// from step to step while the iterations stay near those of a fresh set-up,
+// on the 7-point system of
 // vans_solver.hpp laid out on the whole cell grid (a blocked cell is an
 // identity row). Its cost per cell stays about constant as the grid grows,
 // where the incomplete-Cholesky conjugate gradient's grows with the grid's
@@ -22,10 +24,17 @@ class PressurePfmg {
   PressurePfmg(double tolerance, int max_iterations);
   ~PressurePfmg();
   SolveReport operator()(const PressureSystem& sys, std::vector<double>& x);
-  /// The warm start of the next solve (the last correction on the whole
-  /// grid, empty before the first solve), for checkpoints.
-  std::vector<double> warm_start() const;
-  void set_warm_start(const std::vector<double>& x);
+  /// What the next solve starts from, for checkpoints: the warm start (the
+  /// last correction on the whole grid, empty before the first solve), the
+  /// matrix the kept preconditioner was set up from (empty: none kept) and
+  /// the iteration counts its renewal is decided by.
+  struct Saved {
+    std::vector<double> sol, setup_values;
+    int setup_iterations = 0, last_iterations = 0;
+  };
+  Saved saved() const;
+  /// Before the first solve: the next solves go on as the saved solver's would.
+  void restore(const Saved& saved);
 
  private:
   struct State;

@@ -367,8 +367,9 @@ class Vans {
     }
     ++exchanges_;
     // 4. forces back: the beta of step 2 (the gas's K holds it) with the new gas velocity; the books
-    std::array<std::vector<double>, 3> G;
-    for (int a = 0; a < 3; ++a) G[a] = f.pressure_gradient(a);
+    std::array<std::vector<double>, 3>& G = gradient_;
+    if (pressure_force_)
+      for (int a = 0; a < 3; ++a) f.pressure_gradient(a, G[a]);
     double vmax = 0;
     double drag_sum[3] = {0, 0, 0}, drag_abs[3] = {0, 0, 0};
     for (uint32_t L = 0; L < ex.level_count; ++L) {
@@ -424,19 +425,30 @@ class Vans {
 
   /// Checkpoints (abi.h, ABI 2.3): everything the next exchange reads, so
   /// that a restarted run goes on bit for bit: the solver's fields, the
-  /// pressure solve's warm start, the exchange count (the first exchange
+  /// pressure solve's warm start (and hypre's kept preconditioner: the
+  /// matrix it was set up from), the exchange count (the first exchange
   /// differs), the substep count of "auto", the last solve's figures and
   /// which warnings were given. The layout version comes first.
-  static constexpr std::uint32_t kStateLayout = 1;
+  static constexpr std::uint32_t kStateLayout = 2;
   void save_state(sdk::StateWriter& w) const {
     w.put(kStateLayout);
     solver_->save(w);
-    std::vector<double> warm;
+    std::vector<double> warm, setup_matrix;
+    int setup_iterations = 0, last_iterations = 0;
 #ifdef DOMEL_HAVE_HYPRE
-    if (pfmg_) warm = pfmg_->warm_start();
+    if (pfmg_) {
+      const PressurePfmg::Saved saved = pfmg_->saved();
+      warm = saved.sol;
+      setup_matrix = saved.setup_values;
+      setup_iterations = saved.setup_iterations;
+      last_iterations = saved.last_iterations;
+    }
 #endif
     if (cg_) warm = cg_->warm_start();
     w.put(warm);
+    w.put(setup_matrix);
+    w.put(setup_iterations);
+    w.put(last_iterations);
     w.put(exchanges_);
     w.put(substeps_);
     w.put(substeps_used_max_);
@@ -448,13 +460,20 @@ class Vans {
   }
   void load_state(sdk::StateReader& r) {
     const auto layout = r.get<std::uint32_t>();
-    if (layout != kStateLayout)
-      throw std::runtime_error("the saved state has layout " + std::to_string(layout) + ", this version reads " +
+    if (layout != 1 && layout != kStateLayout)
+      throw std::runtime_error("the saved state has layout " + std::to_string(layout) + ", this version reads 1 and " +
                                std::to_string(kStateLayout));
     solver_->load(r);
     const std::vector<double> warm = r.get_vector<double>();
+    std::vector<double> setup_matrix;  // layout 1 has none: the first solve sets up anew
+    int setup_iterations = 0, last_iterations = 0;
+    if (layout >= 2) {
+      setup_matrix = r.get_vector<double>();
+      setup_iterations = r.get<int>();
+      last_iterations = r.get<int>();
+    }
 #ifdef DOMEL_HAVE_HYPRE
-    if (pfmg_) pfmg_->set_warm_start(warm);
+    if (pfmg_) pfmg_->restore({warm, setup_matrix, setup_iterations, last_iterations});
 #endif
     if (cg_) cg_->set_warm_start(warm);
     exchanges_ = r.get<std::uint64_t>();
@@ -796,6 +815,7 @@ class Vans {
   sdk::Host host_;
   std::unique_ptr<VansSolver> solver_;
   PressureSolver solve_;
+  std::array<std::vector<double>, 3> gradient_;  ///< the pressure gradient on the faces (exchange step 4)
 #ifdef DOMEL_HAVE_HYPRE
   std::shared_ptr<PressurePfmg> pfmg_;  ///< the solver behind solve_ (one of the two), for its warm start
 #endif

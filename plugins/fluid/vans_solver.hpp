@@ -57,6 +57,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -96,6 +97,10 @@ struct PressureSystem {
   std::vector<double> diag;                           ///< per unknown
   std::vector<std::vector<std::pair<std::size_t, double>>> off;  ///< per unknown: (column, value), value < 0
   std::vector<double> rhs;
+  /// Names the pattern (n, cell_of, off's columns): a new value whenever it
+  /// is built, the same while only the values change, so that a solver may
+  /// keep what it derived from the pattern (new_pattern_id())
+  std::uint64_t pattern_id = 0;
   /// |rhs| below which the system counts as solved [1/s]: the round-off of
   /// a fluid at rest would otherwise be iterated on as if it were flow
   double reference_norm = 0;
@@ -114,6 +119,11 @@ struct PressureSystem {
     return bnorm > 0 ? tol * std::max(1.0, reference_norm / bnorm) : tol;
   }
 };
+/// A pattern id no other system in the process has had.
+inline std::uint64_t new_pattern_id() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1);
+}
 struct SolveReport {
   int iterations = 0;
   double residual = 0;
@@ -274,23 +284,32 @@ class VansSolver {
       e0[c] = eps_old_[c] + frac_from * (eps_[c] - eps_old_[c]);
       e1[c] = eps_old_[c] + frac_to * (eps_[c] - eps_old_[c]);
     }
+    // the void fraction on every face at the interval's point this step ends at
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double>& fe = fe1_[a];
+      const auto& co = cells_of_[a];
+      for (std::size_t f = 0; f < fe.size(); ++f) fe[f] = 0.5 * (e1[co[f][0]] + e1[co[f][1]]);
+    }
     // an inlet prescribes the superficial velocity: eps u = U across the face
     // (the gas enters from below a bed as through a distributor)
     for (int a = 0; a < 3; ++a)
-      for (const std::uint32_t f : inlet_faces_[a]) u_[a][f] = inlet_value_[a][f] / face_eps_of(e1, a, f);
+      for (const std::uint32_t f : inlet_faces_[a]) u_[a][f] = inlet_value_[a][f] / fe1_[a][f];
     // predictor, over the free faces
     auto half_slope = [](double d1, double d2) {  // the limited slope's half: van Leer's harmonic mean
       const double p = d1 * d2;
       return p > 0 ? p / (d1 + d2) : 0.0;
     };
     const bool van_leer = s_.advection == Advection::van_leer;
+    const double ih[3] = {1.0 / g.h[0], 1.0 / g.h[1], 1.0 / g.h[2]};
+    const double ih2[3] = {ih[0] * ih[0], ih[1] * ih[1], ih[2] * ih[2]};
+    const double rho_dt = s_.rho / dt;
     for (int a = 0; a < 3; ++a) {
       const std::vector<double>& ua = u_[a];
+      const std::vector<double>& fe = fe1_[a];
       us_[a] = ua;
-      std::fill(A_[a].begin(), A_[a].end(), 0.0);
       for (const FaceStencil& st : stencil_[a]) {
         const std::size_t f = st.f;
-        const double ef1 = face_eps_of(e1, a, f);
+        const double ef1 = fe[f];
         const double un = ua[f];
         // advection (upwind or van Leer) and diffusion of u_a
         double adv = 0, lap = 0;
@@ -299,7 +318,7 @@ class VansSolver {
           if (b != a) {  // the mean of the b-faces around this one
             double sum = 0;
             for (int q = 0; q < st.n_cross[m]; ++q) sum += u_[b][st.cross[m][q]];
-            ub = st.n_cross[m] ? sum / st.n_cross[m] : 0.0;
+            ub = sum * st.cross_weight[m];
             ++m;
           }
           const double um = value(st.near[b][0], ua), up = value(st.near[b][1], ua);
@@ -307,38 +326,41 @@ class VansSolver {
             const double u_mm = value(st.far[b][0], ua), u_pp = value(st.far[b][1], ua);
             const double hi_face = ub > 0 ? un + half_slope(un - um, up - un) : up - half_slope(u_pp - up, up - un);
             const double lo_face = ub > 0 ? um + half_slope(um - u_mm, un - um) : un - half_slope(up - un, un - um);
-            adv += ub * (hi_face - lo_face) / g.h[b];
+            adv += ub * (hi_face - lo_face) * ih[b];
           } else {
-            adv += ub > 0 ? ub * (un - um) / g.h[b] : ub * (up - un) / g.h[b];
+            adv += ub * (ub > 0 ? un - um : up - un) * ih[b];
           }
-          lap += (up - 2 * un + um) / (g.h[b] * g.h[b]);
+          lap += (up - 2 * un + um) * ih2[b];
         }
-        const double gradp = st.outlet ? outlet_gradient(p_, a, f) : (p_[cells_of_[a][f][1]] - p_[cells_of_[a][f][0]]) / g.h[a];
+        const double gradp = st.outlet ? outlet_gradient(p_, a, f) : (p_[cells_of_[a][f][1]] - p_[cells_of_[a][f][0]]) * ih[a];
         const double R = -s_.rho * ef1 * adv + s_.mu * ef1 * lap - ef1 * gradp + s_.rho * ef1 * s_.gravity[a];
-        const double K = K_[a][f];
-        us_[a][f] = (s_.rho * ef1 * un / dt + R + Ku_[a][f]) / (s_.rho * ef1 / dt + K);
-        A_[a][f] = ef1 * dt / (s_.rho * ef1 + K * dt);
+        // the drag implicit: u* (rho eps / dt + K) = rho eps u^n / dt + R + K u_s
+        const double inv = 1.0 / (rho_dt * ef1 + K_[a][f]);
+        us_[a][f] = (rho_dt * ef1 * un + R + Ku_[a][f]) * inv;
+        A_[a][f] = ef1 * inv;  // eps dt / (rho eps + K dt)
       }
     }
     // pressure system: its pattern is the constructor's, its values this step's
     PressureSystem& sys = sys_;
+    const double inv_dt = 1.0 / dt;
     for (std::size_t P = 0; P < n_unknowns_; ++P) {
       double div = 0, diag = 0;
       for (const CellFace& cf : cell_faces_[P]) {
         const int a = cf.axis;
-        const double ef = face_eps_of(e1, a, cf.f);
-        div += (cf.high ? 1.0 : -1.0) * ef * us_[a][cf.f] / g.h[a];
+        const double ef = fe1_[a][cf.f];
+        const double flux = ef * us_[a][cf.f] * ih[a];
+        div += cf.high ? flux : -flux;
         if (cf.kind == FaceKind::interior) {
-          const double coef = ef * A_[a][cf.f] / (g.h[a] * g.h[a]);
+          const double coef = ef * A_[a][cf.f] * ih2[a];
           diag += coef;
           if (cf.slot >= 0) sys.off[P][static_cast<std::size_t>(cf.slot)].second = -coef;
         } else if (cf.kind == FaceKind::outlet) {
-          diag += ef * A_[a][cf.f] / (g.h[a] * 0.5 * g.h[a]);
+          diag += 2.0 * ef * A_[a][cf.f] * ih2[a];  // p' = 0 half a cell beyond the last centre
         }
       }
       const std::size_t c = sys.cell_of[P];
       sys.diag[P] = diag;
-      sys.rhs[P] = -(div + (e1[c] - e0[c]) / dt);
+      sys.rhs[P] = -(div + (e1[c] - e0[c]) * inv_dt);
     }
     if (closed_ && n_unknowns_ > 0) sys.rhs[0] = 0;  // p' = 0 in the first fluid cell (its row and column left out)
     {
@@ -376,33 +398,16 @@ class VansSolver {
   }
 
   /// Gradient of the pressure on the face grid of axis a (for the particles'
-  /// pressure-gradient force): the face difference where the face is free,
-  /// the nearest free face's along a where it is fixed (a wall has the
-  /// gradient of the fluid beside it, e.g. the hydrostatic one).
-  std::vector<double> pressure_gradient(int a) const {
+  /// pressure-gradient force), into G: the face difference where the face is
+  /// free, the nearest free face's along a where it is fixed (a wall has the
+  /// gradient of the fluid beside it, e.g. the hydrostatic one), 0 where
+  /// neither neighbour along a is free.
+  void pressure_gradient(int a, std::vector<double>& G) const {
     const MacGrid& g = s_.grid;
-    std::vector<double> G(g.faces(a), 0.0);
-    for_faces(a, [&](int i, int j, int k, std::size_t f) {
-      const FaceKind kd = kind_[a][f];
-      if (kd == FaceKind::interior || kd == FaceKind::outlet) G[f] = face_gradient(p_, a, i, j, k, kd);
-    });
-    // fixed faces: copy inward along a
-    for_faces(a, [&](int i, int j, int k, std::size_t f) {
-      const FaceKind kd = kind_[a][f];
-      if (kd == FaceKind::interior || kd == FaceKind::outlet) return;
-      int idx[3] = {i, j, k};
-      for (int step : {+1, -1}) {
-        int q[3] = {idx[0], idx[1], idx[2]};
-        q[a] += step;
-        if (q[a] < 0 || q[a] > g.n[a]) continue;
-        const std::size_t fq = g.face(a, q[0], q[1], q[2]);
-        if (kind_[a][fq] == FaceKind::interior || kind_[a][fq] == FaceKind::outlet) {
-          G[f] = face_gradient(p_, a, q[0], q[1], q[2], kind_[a][fq]);
-          return;
-        }
-      }
-    });
-    return G;
+    G.assign(g.faces(a), 0.0);
+    for (const std::uint32_t f : interior_faces_[a]) G[f] = (p_[cells_of_[a][f][1]] - p_[cells_of_[a][f][0]]) / g.h[a];
+    for (const auto& of : outlet_faces_[a]) G[of.first] = outlet_gradient(p_, a, of.first);
+    for (const auto& [f, from] : gradient_copies_[a]) G[f] = G[from];
   }
 
   /// Cell-centred velocity (mean of the two faces along each axis).
@@ -596,6 +601,7 @@ class VansSolver {
     Rule far[3][2];                     ///< two faces back and ahead (van Leer's stencil), where far_ok has bit b
     std::uint32_t cross[2][4] = {};     ///< the b-faces whose mean is u_b here, for the two b != a in order
     std::uint8_t n_cross[2] = {0, 0};
+    double cross_weight[2] = {0, 0};    ///< 1 / n_cross (0 where none)
     std::uint8_t far_ok = 0;
     bool outlet = false;
   };
@@ -695,7 +701,8 @@ class VansSolver {
       outlet_faces_[a].clear();
       stencil_[a].clear();
       us_[a].assign(g.faces(a), 0.0);
-      A_[a].assign(g.faces(a), 0.0);
+      A_[a].assign(g.faces(a), 0.0);  // stays 0 on the fixed faces; the step writes the free ones
+      fe1_[a].assign(g.faces(a), 0.0);
       for_faces(a, [&](int i, int j, int k, std::size_t f) {
         const int idx[3] = {i, j, k};
         int l[3] = {i, j, k};
@@ -727,13 +734,32 @@ class VansSolver {
             }
           ++m;
         }
+        for (int q = 0; q < 2; ++q) st.cross_weight[q] = st.n_cross[q] ? 1.0 / st.n_cross[q] : 0.0;
         stencil_[a].push_back(st);
+      });
+      // a fixed face's pressure gradient: the free face's one step up along a, else one step down
+      gradient_copies_[a].clear();
+      for_faces(a, [&](int i, int j, int k, std::size_t f) {
+        const auto free = [&](std::size_t q) { return kind_[a][q] == FaceKind::interior || kind_[a][q] == FaceKind::outlet; };
+        if (free(f)) return;
+        const int idx[3] = {i, j, k};
+        for (int step : {+1, -1}) {
+          int q[3] = {idx[0], idx[1], idx[2]};
+          q[a] += step;
+          if (q[a] < 0 || q[a] > g.n[a]) continue;
+          const std::size_t fq = g.face(a, q[0], q[1], q[2]);
+          if (free(fq)) {
+            gradient_copies_[a].push_back({static_cast<std::uint32_t>(f), static_cast<std::uint32_t>(fq)});
+            return;
+          }
+        }
       });
     }
     e0_.assign(g.cells(), 0.0);
     e1_.assign(g.cells(), 0.0);
     pc_.assign(n_unknowns_, 0.0);
     sys_ = PressureSystem{};
+    sys_.pattern_id = new_pattern_id();
     sys_.n = g.n;
     sys_.cell_of.assign(n_unknowns_, 0);
     sys_.diag.assign(n_unknowns_, 0.0);
@@ -799,7 +825,8 @@ class VansSolver {
   std::vector<std::array<CellFace, 6>> cell_faces_;  ///< per unknown
   // the step's work arrays, kept between steps
   std::vector<double> e0_, e1_, pc_;
-  std::array<std::vector<double>, 3> us_, A_;
+  std::array<std::vector<std::pair<std::uint32_t, std::uint32_t>>, 3> gradient_copies_;  ///< (fixed face, free face it copies)
+  std::array<std::vector<double>, 3> us_, A_, fe1_;  ///< fe1_: eps on the faces where the step ends
   PressureSystem sys_;
 };
 
