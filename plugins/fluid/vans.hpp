@@ -95,7 +95,7 @@ class Vans {
     "initial_velocity": { "type": "array", "items": { "type": "number" }, "minItems": 3, "maxItems": 3, "default": [0, 0, 0], "x-unit": "m/s", "description": "fluid velocity at the start" },
     "solver": { "type": "object", "default": {}, "properties": {
         "backend": { "enum": ["auto", "cg", "pfmg"], "default": "auto", "description": "pressure solve: cg = Eigen's conjugate gradient with incomplete Cholesky (cost per cell grows with the grid); pfmg = hypre's structured multigrid (PFMG-preconditioned CG; cost per cell about constant; needs a domel built with Debian's libhypre-dev); auto = pfmg when available, else cg" },
-        "tolerance": { "type": "number", "exclusiveMinimum": 0, "default": 1e-8, "x-unit": "1", "description": "relative residual of the pressure solve" },
+        "tolerance": { "type": "number", "exclusiveMinimum": 0, "default": 1e-6, "x-unit": "1", "description": "relative residual of the pressure solve: the divergence it leaves, against the flow's rate of strain (docs/fluid.md)" },
         "max_iterations": { "type": "integer", "minimum": 1, "maximum": 100000000, "default": 2000, "description": "iterations of the pressure solve" } },
       "additionalProperties": false }
   },
@@ -214,7 +214,7 @@ class Vans {
     max_substeps_ = j.value("max_substeps", 16);
     cfl_ = j.value("cfl", 0.5);
     const nlohmann::json solver = j.value("solver", nlohmann::json::object());
-    const double tol = solver.value("tolerance", 1e-8);
+    const double tol = solver.value("tolerance", 1e-6);
     const int max_it = solver.value("max_iterations", 2000);
     std::string backend = solver.value("backend", std::string("auto"));
 #ifdef DOMEL_HAVE_HYPRE
