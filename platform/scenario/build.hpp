@@ -59,6 +59,8 @@ void build_walls(Build& b);
 void build_run(Build& b);
 // build_subdomains.cpp
 void build_subdomain(Build& b, std::size_t k);
+/// False (and reported) when a level has more steps per macro step than an int counts.
+bool check_level_steps(Build& b);
 void build_rank_shares(Build& b);
 // builders.cpp
 /// The index of a subdomain named at `pointer`; an unknown name is reported

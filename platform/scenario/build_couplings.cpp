@@ -472,7 +472,9 @@ void build_couplings(Build& b) {
                    "step, so that every exchange falls on a step of every level",
                    base, s.fine_steps, requested[c], control_macro, macro);
     const int tmax = cj["transfer_max_steps"].get<int>();
-    s.transfer_controls = std::max<std::uint64_t>(1, (tmax + s.fine_steps - 1) / s.fine_steps);
+    s.transfer_controls =
+        std::max<std::uint64_t>(1, (static_cast<std::uint64_t>(tmax) + static_cast<std::uint64_t>(s.fine_steps) - 1) /
+                                       static_cast<std::uint64_t>(s.fine_steps));
     const double dt_f = macro / n_f, dt_c = macro / n_c;
     // What the controllers are set up for (ABI 2.5): the levels' steps per
     // control interval and time steps, the grid, and the inflow cells (those

@@ -5,6 +5,7 @@
 #include "scenario/build.hpp"
 
 #include "geometry/region.hpp"
+#include "loop/macro_step.hpp"
 #include "geometry/wall_clearance.hpp"
 #include "io/particle_state.hpp"
 #include "subdomain/diagnostics.hpp"
@@ -619,6 +620,35 @@ void build_subdomain(Build& b, std::size_t k) {
   if (!set_time_step(b, *sub, sd, base, pour_radii, rep)) return;
   b.sim.time_steps.push_back(rep);
   b.sim.subdomains.push_back(std::move(sub));
+}
+
+/// A level sub-cycles macro step / its time step steps per macro step,
+/// counted in an int (substeps_of): a level whose step is more than that many
+/// times shorter than the longest (an empty level given 5e-324 s beside one
+/// of 2e-6 s: the run-time fuzzer) would have its step silently lengthened
+/// to fit, by hundreds of orders of magnitude. Refused at its time step.
+bool check_level_steps(Build& b) {
+  const auto& sds = b.sim.subdomains;
+  if (sds.size() < 2 || sds.size() != b.doc["subdomains"].size()) return true;
+  const double macro = macro_step_of(sds);
+  std::size_t longest = 0;
+  for (std::size_t k = 1; k < sds.size(); ++k)
+    if (sds[k]->time_step() > sds[longest]->time_step()) longest = k;
+  bool ok = true;
+  for (std::size_t k = 0; k < sds.size(); ++k) {
+    const double n = std::ceil(macro / sds[k]->time_step() - kTimeTolerance);
+    if (n < static_cast<double>(std::numeric_limits<int>::max())) continue;
+    ok = false;
+    const json& sd = b.doc["subdomains"][k];
+    b.ck.add(idx("/subdomains", k) + (member(sd, "time_step") ? "/time_step" : ""),
+             "the time step " + fmt_num(sds[k]->time_step()) + " s of subdomain '" + sds[k]->name() +
+                 "' goes more than " + std::to_string(std::numeric_limits<int>::max()) +
+                 " times (the most a level can count) into the macro step, " + fmt_num(macro) + " s (subdomain '" +
+                 sds[longest]->name() + "''s)",
+             "give the levels time steps within a factor of 1e9 of each other (coarse-graining by alpha changes the "
+             "step by about alpha)");
+  }
+  return ok;
 }
 
 /// subdomains[].rank_share: on every subdomain or on none.

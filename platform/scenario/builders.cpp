@@ -36,8 +36,9 @@ std::unique_ptr<Simulation> build(const json& doc, const std::filesystem::path& 
   build_run(b);
   scan_couplings(b);
   for (std::size_t k = 0; k < doc["subdomains"].size(); ++k) build_subdomain(b, k);
+  const bool steps_counted = check_level_steps(b);
   build_rank_shares(b);
-  if (b.sim.subdomains.size() == doc["subdomains"].size()) build_couplings(b);
+  if (steps_counted && b.sim.subdomains.size() == doc["subdomains"].size()) build_couplings(b);
   build_particle_flow(b);
   if (b.ck.diags.empty()) warn_shared_space(b);
   build_grids(b);
