@@ -307,23 +307,20 @@ class VansSolver {
       const std::vector<double>& ua = u_[a];
       const std::vector<double>& fe = fe1_[a];
       us_[a] = ua;
-      for (const FaceStencil& st : stencil_[a]) {
-        const std::size_t f = st.f;
+      // one face's update: u_a's neighbours along b (near(b, side), far(b,
+      // side) two faces out) and u_b's mean around the face (cross(b, m)),
+      // read through the accessors of the face's kind of stencil
+      auto update = [&](std::size_t f, bool outlet, unsigned far_ok, auto&& near, auto&& far, auto&& cross) {
         const double ef1 = fe[f];
         const double un = ua[f];
         // advection (upwind or van Leer) and diffusion of u_a
         double adv = 0, lap = 0;
         for (int b = 0, m = 0; b < 3; ++b) {
           double ub = un;
-          if (b != a) {  // the mean of the b-faces around this one
-            double sum = 0;
-            for (int q = 0; q < st.n_cross[m]; ++q) sum += u_[b][st.cross[m][q]];
-            ub = sum * st.cross_weight[m];
-            ++m;
-          }
-          const double um = value(st.near[b][0], ua), up = value(st.near[b][1], ua);
-          if (van_leer && (st.far_ok >> b & 1)) {
-            const double u_mm = value(st.far[b][0], ua), u_pp = value(st.far[b][1], ua);
+          if (b != a) ub = cross(b, m++);  // the mean of the b-faces around this one
+          const double um = near(b, 0), up = near(b, 1);
+          if (van_leer && (far_ok >> b & 1)) {
+            const double u_mm = far(b, 0), u_pp = far(b, 1);
             const double hi_face = ub > 0 ? un + half_slope(un - um, up - un) : up - half_slope(u_pp - up, up - un);
             const double lo_face = ub > 0 ? um + half_slope(um - u_mm, un - um) : un - half_slope(up - un, un - um);
             adv += ub * (hi_face - lo_face) * ih[b];
@@ -332,12 +329,34 @@ class VansSolver {
           }
           lap += (up - 2 * un + um) * ih2[b];
         }
-        const double gradp = st.outlet ? outlet_gradient(p_, a, f) : (p_[cells_of_[a][f][1]] - p_[cells_of_[a][f][0]]) * ih[a];
+        const double gradp = outlet ? outlet_gradient(p_, a, f) : (p_[cells_of_[a][f][1]] - p_[cells_of_[a][f][0]]) * ih[a];
         const double R = -s_.rho * ef1 * adv + s_.mu * ef1 * lap - ef1 * gradp + s_.rho * ef1 * s_.gravity[a];
         // the drag implicit: u* (rho eps / dt + K) = rho eps u^n / dt + R + K u_s
         const double inv = 1.0 / (rho_dt * ef1 + K_[a][f]);
         us_[a][f] = (rho_dt * ef1 * un + R + Ku_[a][f]) * inv;
         A_[a][f] = ef1 * inv;  // eps dt / (rho eps + K dt)
+      };
+      for (const FaceStencil& st : stencil_[a])
+        update(
+            st.f, st.outlet, st.far_ok, [&](int b, int side) { return value(st.near[b][side], ua); },
+            [&](int b, int side) { return value(st.far[b][side], ua); },
+            [&](int b, int m) {
+              double sum = 0;
+              for (int q = 0; q < st.n_cross[m]; ++q) sum += u_[b][st.cross[m][q]];
+              return sum * st.cross_weight[m];
+            });
+      // the faces whose neighbours are all inside the box and free: strides
+      const PlainStrides& ps = plain_strides_[a];
+      for (const PlainFace& pf : plain_[a]) {
+        const std::size_t f = pf.f;
+        update(
+            f, false, 7u, [&](int b, int side) { return side ? ua[f + ps.along[b]] : ua[f - ps.along[b]]; },
+            [&](int b, int side) { return side ? ua[f + 2 * ps.along[b]] : ua[f - 2 * ps.along[b]]; },
+            [&](int b, int m) {  // the order FaceStencil::cross keeps: back along a, then along b
+              const std::vector<double>& ub = u_[b];
+              const std::size_t q = pf.cross[m], sb = ps.cross_b[m], sa = ps.cross_a[m];
+              return (((ub[q] + ub[q + sb]) + ub[q + sa]) + ub[q + sa + sb]) * 0.25;
+            });
       }
     }
     // pressure system: its pattern is the constructor's, its values this step's
@@ -605,6 +624,19 @@ class VansSolver {
     std::uint8_t far_ok = 0;
     bool outlet = false;
   };
+  /// A free face whose neighbours along every axis (two out, for van Leer)
+  /// are faces of the box read as they are, and whose u_b means have four
+  /// faces each: read by strides (PlainStrides) instead of rules.
+  struct PlainFace {
+    std::uint32_t f = 0;
+    std::uint32_t cross[2] = {0, 0};  ///< per b != a in order: the first of the four b-faces (back along a)
+  };
+  /// Strides of axis a's plain faces: along[b] in the a-face grid; for the
+  /// two b != a in order, the b-face grid's strides along b and along a.
+  struct PlainStrides {
+    std::size_t along[3] = {0, 0, 0};
+    std::size_t cross_b[2] = {0, 0}, cross_a[2] = {0, 0};
+  };
   /// One of a fluid cell's six faces, for the pressure system.
   struct CellFace {
     std::uint32_t f = 0;
@@ -687,6 +719,28 @@ class VansSolver {
     return true;
   }
 
+  /// Whether a free face's stencil is what plain_strides_ reads: every
+  /// neighbour rule (and, with van Leer, every far rule) the face a stride
+  /// away as it is, and four b-faces in each u_b mean at the strides.
+  bool plain(int a, const FaceStencil& st) const {
+    if (st.outlet) return false;
+    const PlainStrides& ps = plain_strides_[a];
+    const bool van_leer = s_.advection == Advection::van_leer;
+    if (van_leer && st.far_ok != 7) return false;
+    auto is = [](const Rule& r, std::size_t idx) { return !r.negate && r.offset == 0 && r.idx == idx; };
+    for (int b = 0; b < 3; ++b) {
+      const std::size_t s = ps.along[b];
+      if (st.f < 2 * s || !is(st.near[b][0], st.f - s) || !is(st.near[b][1], st.f + s)) return false;
+      if (van_leer && (!is(st.far[b][0], st.f - 2 * s) || !is(st.far[b][1], st.f + 2 * s))) return false;
+    }
+    for (int m = 0; m < 2; ++m) {
+      const std::size_t q = st.cross[m][0], sb = ps.cross_b[m], sa = ps.cross_a[m];
+      if (st.n_cross[m] != 4 || st.cross[m][1] != q + sb || st.cross[m][2] != q + sa || st.cross[m][3] != q + sa + sb)
+        return false;
+    }
+    return true;
+  }
+
   /// The stencils (FaceStencil per free face), the cells beside every face,
   /// the inlet faces, and the pressure system's pattern (CellFace per fluid
   /// cell; the off-diagonals in the order the faces are visited, none to or
@@ -700,6 +754,17 @@ class VansSolver {
       interior_faces_[a].clear();
       outlet_faces_[a].clear();
       stencil_[a].clear();
+      plain_[a].clear();
+      {
+        PlainStrides& ps = plain_strides_[a];
+        for (int b = 0; b < 3; ++b) ps.along[b] = g.face(a, b == 0, b == 1, b == 2);
+        for (int b = 0, m = 0; b < 3; ++b) {
+          if (b == a) continue;
+          ps.cross_b[m] = g.face(b, b == 0, b == 1, b == 2);
+          ps.cross_a[m] = g.face(b, a == 0, a == 1, a == 2);
+          ++m;
+        }
+      }
       us_[a].assign(g.faces(a), 0.0);
       A_[a].assign(g.faces(a), 0.0);  // stays 0 on the fixed faces; the step writes the free ones
       fe1_[a].assign(g.faces(a), 0.0);
@@ -735,6 +800,10 @@ class VansSolver {
           ++m;
         }
         for (int q = 0; q < 2; ++q) st.cross_weight[q] = st.n_cross[q] ? 1.0 / st.n_cross[q] : 0.0;
+        if (plain(a, st)) {
+          plain_[a].push_back({st.f, {st.cross[0][0], st.cross[1][0]}});
+          return;
+        }
         stencil_[a].push_back(st);
       });
       // a fixed face's pressure gradient: the free face's one step up along a, else one step down
@@ -825,6 +894,8 @@ class VansSolver {
   std::vector<std::array<CellFace, 6>> cell_faces_;  ///< per unknown
   // the step's work arrays, kept between steps
   std::vector<double> e0_, e1_, pc_;
+  std::array<std::vector<PlainFace>, 3> plain_;  ///< the free faces read by strides (the rest: stencil_)
+  std::array<PlainStrides, 3> plain_strides_;
   std::array<std::vector<std::pair<std::uint32_t, std::uint32_t>>, 3> gradient_copies_;  ///< (fixed face, free face it copies)
   std::array<std::vector<double>, 3> us_, A_, fe1_;  ///< fe1_: eps on the faces where the step ends
   PressureSystem sys_;
