@@ -109,15 +109,18 @@ PressurePfmg::PressurePfmg(double tolerance, int max_iterations)
 PressurePfmg::~PressurePfmg() = default;
 
 PressurePfmg::Saved PressurePfmg::saved() const {
-  return Saved{s_->sol, s_->pcg ? s_->setup_values : std::vector<double>{}, s_->setup_iterations, s_->last_iterations};
+  // a restored solver that has not solved yet still holds the checkpoint's matrix
+  return Saved{s_->sol, s_->pcg || s_->restored ? s_->setup_values : std::vector<double>{}, s_->setup_iterations,
+               s_->last_iterations};
 }
 
 void PressurePfmg::restore(const Saved& saved) {
+  s_->drop_preconditioner();  // one built before the restore belongs to another matrix
   s_->sol = saved.sol;
   s_->setup_values = saved.setup_values;
   s_->setup_iterations = saved.setup_iterations;
   s_->last_iterations = saved.last_iterations;
-  s_->restored = s_->grid == nullptr;
+  s_->restored = true;
 }
 
 SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<double>& x) {
@@ -168,7 +171,7 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     if (!restoring) s.setup_values.clear();
     s.pattern.clear();
     s.entry.clear();
-    s.pattern_id = sys.pattern_id;
+    s.pattern_id = 0;  // named only once the pattern below is complete
     s.cell_of = sys.cell_of;
     s.fluid.assign(cells, 0);
     for (std::size_t r = 0; r < sys.diag.size(); ++r) {
@@ -192,6 +195,7 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
         s.entry.push_back(static_cast<std::uint8_t>(e));
       }
     }
+    s.pattern_id = sys.pattern_id;
   }
   // the 7-point rows on the whole grid: identity rows for blocked cells,
   // written with the pattern; a fluid row's entries are this system's
@@ -245,13 +249,16 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     HYPRE_StructPCGSetup(s.pcg, s.A, s.b, s.x);
     if (&from != &s.setup_values) s.setup_values = from;
   };
+  // the same decision a restarted run takes: the renewal rule first, then the
+  // checkpointed run's preconditioner (to the bit), else the kept one
   bool fresh = false;
   s.restored = false;
-  if (restoring && !s.setup_values.empty()) {
-    set_up(s.setup_values);  // the checkpointed run's preconditioner, to the bit
-  } else if (!s.pcg || s.last_iterations > s.setup_iterations + kStaleIterations) {
+  const bool stale = s.last_iterations > s.setup_iterations + kStaleIterations;
+  if (stale || (!s.pcg && !(restoring && !s.setup_values.empty()))) {
     set_up(s.values);
     fresh = true;
+  } else if (!s.pcg) {
+    set_up(s.setup_values);
   }
   set_matrix(s.values);
   const double rtol = sys.relative_tolerance(tol_, bn);
@@ -261,7 +268,11 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
   HYPRE_StructPCGSolve(s.pcg, s.A, s.b, s.x);
   HYPRE_StructPCGGetNumIterations(s.pcg, &it);
   HYPRE_StructPCGGetFinalRelativeResidualNorm(s.pcg, &res);
-  if (!fresh && !(res <= rtol)) {
+  // hypre stops at |r|^2 < rtol^2 |b|^2 and reports the root: a converged
+  // solve may read an ulp above rtol
+  const bool converged = res <= rtol * (1 + 1e-12);
+  HYPRE_Int counted = it;  // what the renewal rule reads: the iterations of the solve that ended it
+  if (!fresh && !converged) {
     // an old preconditioner that no longer gets there within max_iterations:
     // build it anew and solve again from where the first try stopped
     HYPRE_StructVectorGetBoxValues(s.x, lower, upper, s.sol.data());
@@ -274,9 +285,10 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     HYPRE_StructPCGGetNumIterations(s.pcg, &more);
     HYPRE_StructPCGGetFinalRelativeResidualNorm(s.pcg, &res);
     it += more;
+    counted = more;
   }
   HYPRE_StructVectorGetBoxValues(s.x, lower, upper, s.sol.data());
-  s.last_iterations = static_cast<int>(it);
+  s.last_iterations = static_cast<int>(counted);
   if (fresh) s.setup_iterations = s.last_iterations;
   for (std::size_t r = 0; r < sys.diag.size(); ++r) x[r] = s.sol[sys.cell_of[r]];
   rep.iterations = static_cast<int>(it);
