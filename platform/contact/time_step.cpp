@@ -188,6 +188,13 @@ TimeStepProblem choose_time_step(const std::string& subdomain, TimeStepReport& r
   rep.reason = rep.chosen == by_rayleigh  ? "auto: 0.2 x Rayleigh time"
                : rep.chosen == by_contact ? "auto: contact time / 50"
                                           : "auto: half the stability limit of the " + rep.critical_of;
+  // particles so small that their times underflow (a diameter of 5e-324 m:
+  // the run-time fuzzer) give a step of 0 s, which no run can take
+  if (!(rep.chosen > 0) || !std::isfinite(rep.chosen))
+    return {"the automatic time step is " + seconds(rep.chosen) + " s (0.2 x Rayleigh time " + seconds(rep.rayleigh) +
+                " s, contact time " + seconds(rep.contact_time) + " s at " + seconds(impact_velocity) +
+                " m/s): no run can step with it",
+            "check the particles' diameters (SI units: metres) and the contact's stiffness, or give time_step"};
   return {};
 }
 
