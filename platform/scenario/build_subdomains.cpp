@@ -636,8 +636,7 @@ bool check_level_steps(Build& b) {
     if (sds[k]->time_step() > sds[longest]->time_step()) longest = k;
   bool ok = true;
   for (std::size_t k = 0; k < sds.size(); ++k) {
-    const double n = std::ceil(macro / sds[k]->time_step() - kTimeTolerance);
-    if (n < static_cast<double>(std::numeric_limits<int>::max())) continue;
+    if (substeps_of(macro, sds[k]->time_step()) < std::numeric_limits<int>::max()) continue;  // it saturates
     ok = false;
     const json& sd = b.doc["subdomains"][k];
     b.ck.add(idx("/subdomains", k) + (member(sd, "time_step") ? "/time_step" : ""),

@@ -66,8 +66,6 @@ struct PressurePfmg::State {
   int last_iterations = 0;                  ///< the last solve's
   std::vector<char> fluid;                  ///< per cell: an unknown of the system
   std::uint64_t pattern_id = 0;             ///< the system's pattern id, as last seen (0: none)
-  std::vector<std::size_t> pattern;         ///< the off-diagonals' columns, row after row, as last seen
-  std::vector<std::size_t> cell_of;         ///< the unknowns' cells, as last seen
   std::vector<std::uint8_t> entry;          ///< each one's stencil entry (1-6)
   bool restored = false;  ///< sol (and the set-up's matrix) came from a checkpoint: the first solve keeps them
 
@@ -143,36 +141,21 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
     HYPRE_StructVectorCreate(MPI_COMM_SELF, s.grid, &s.x);
     HYPRE_StructVectorInitialize(s.x);
     s.n = sys.n;
-    s.pattern.clear();  // the stencil entries belong to the old grid
+    s.pattern_id = 0;  // the stencil entries belong to the old grid
     s.fluid.clear();
     if (!restoring || s.sol.size() != cells) s.sol.assign(cells, 0.0);
     if (!restoring || s.setup_values.size() != 7 * cells) s.setup_values.clear();
   }
   // the stencil entry of each off-diagonal, found again only when the
   // system's pattern changes (the coupler's stays the same from step to step:
-  // its pattern id says so; a system without one is compared entry by entry)
-  bool same = sys.pattern_id != 0 && sys.pattern_id == s.pattern_id && s.fluid.size() == cells;
-  if (sys.pattern_id == 0) {
-    std::size_t q = 0;
-    same = true;
-    for (std::size_t r = 0; r < sys.diag.size() && same; ++r)
-      for (const auto& [col, v] : sys.off[r]) {
-        if (q >= s.pattern.size() || s.pattern[q] != col) {
-          same = false;
-          break;
-        }
-        ++q;
-      }
-    same = same && q == s.pattern.size() && s.fluid.size() == cells && s.cell_of == sys.cell_of;
-  }
+  // its pattern id says so; a system without an id is taken as new each time)
+  const bool same = sys.pattern_id != 0 && sys.pattern_id == s.pattern_id && s.fluid.size() == cells;
   const auto nx = static_cast<std::size_t>(sys.n[0]), nxy = nx * static_cast<std::size_t>(sys.n[1]);
   if (!same) {
     s.drop_preconditioner();  // built for other unknowns (a checkpoint's set-up matrix is kept for the first solve)
     if (!restoring) s.setup_values.clear();
-    s.pattern.clear();
     s.entry.clear();
     s.pattern_id = 0;  // named only once the pattern below is complete
-    s.cell_of = sys.cell_of;
     s.fluid.assign(cells, 0);
     for (std::size_t r = 0; r < sys.diag.size(); ++r) {
       const std::size_t c = sys.cell_of[r];
@@ -191,7 +174,6 @@ SolveReport PressurePfmg::operator()(const PressureSystem& sys, std::vector<doub
         else if (di == 0 && dj == 0 && dk == -1) e = 5;
         else if (di == 0 && dj == 0 && dk == 1) e = 6;
         else throw std::logic_error("pressure system: a coupling that is not a grid neighbour");
-        s.pattern.push_back(col);
         s.entry.push_back(static_cast<std::uint8_t>(e));
       }
     }
