@@ -13,6 +13,14 @@
       its particles, the mass carried out at the top, the largest overlap
       seen, the angle of repose (when a heap can be fitted), the wall time
       and the fluid coupler's share of it (issue 16 item 6)
+  plot_chamber.py heaps RUNS_DIR   the heap runs of issue 45 items 3 and 4
+      (RUNS_DIR/{heap,still}_a<alpha>_{none,sd}_s<seed>, as run_chamber.sh
+      heaps leaves them): per feed, rolling model and alpha the angle on the
+      plate at the end of each seed, their mean and spread, the probe's
+      resolution (one parcel layer over the plate's radius, atan(alpha d / R)),
+      the mass at rest per seed; then, per feed, the paper's claim read off
+      the means: S-D within 10 % of its alpha = 4 angle at every alpha, and
+      'none' falling from alpha = 4 to 8 by more than the resolution
 
 Reads only domel's own files (fluid_*.vti, particles_*.vtp, *.pvd,
 probes.csv, summary.json) with vti.py, without the VTK Python package."""
@@ -117,7 +125,7 @@ def profile(out, pairs):
     ax.set_ylabel("surface height above the plate [mm]")
     ax.set_title("Heap surface on the plate at the end (particles at rest)")
     ax.set_xlim(0, 13)
-    ax.set_ylim(0, 8)
+    ax.set_ylim(0, 10)
     ax.set_aspect("equal")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
@@ -139,12 +147,62 @@ def table(pairs):
         mean = sum(float(r["plate_heap.mass_kg"]) for r in last) / len(last)
         overlap = max(float(r["beads.max_overlap_ratio"]) for r in rows)
         angle = s.get("repose_angle_deg", {}).get("beads")
-        fl = s["fluid"]
+        fl = s.get("fluid")
         out = rows[-1].get("top_outlet.removed_kg", "nan")
+        coupler = (f"{fl['coupler_seconds_per_exchange'] * 1e3:.1f}, {fl['coupler_seconds'] / s['wall_time_s']:.0%}"
+                   if fl else "no gas")
         print(f"| {label} | {float(rows[-1]['plate_heap.mass_kg']) * 1e6:.1f} | {mean * 1e6:.1f} "
               f"| {rows[-1]['plate_heap.particles']} | {float(out) * 1e3:.3f} | {overlap:.3f} "
-              f"| {'–' if angle is None else f'{angle:.1f}'} | {s['wall_time_s']:.0f} "
-              f"| {fl['coupler_seconds_per_exchange'] * 1e3:.1f}, {fl['coupler_seconds'] / s['wall_time_s']:.0%} |")
+              f"| {'–' if angle is None else f'{angle:.1f}'} | {s['wall_time_s']:.0f} | {coupler} |")
+
+
+def heaps(folder):
+    """The heap runs' table and the claim (docs/validation/chamber.md, 'The heap runs')."""
+    runs = {}
+    for name in sorted(os.listdir(folder)):
+        m = re.match(r"(heap|still)_a(\d+)_(none|sd)_s(\d+)$", name)
+        path = os.path.join(folder, name, "summary.json")
+        if not m or not os.path.isfile(path):
+            continue
+        s = json.load(open(path))
+        rows = list(csv.DictReader(open(os.path.join(folder, name, "probes.csv"))))
+        angle = s.get("repose_angle_deg", {}).get("beads")
+        runs.setdefault((m.group(1), m.group(3), int(m.group(2))), []).append(
+            (int(m.group(4)), angle, float(rows[-1]["plate_heap.mass_kg"]), s["wall_time_s"]))
+    if not runs:
+        sys.exit(f"plot_chamber.py heaps: no {{heap,still}}_a<alpha>_<rolling>_s<seed>/summary.json in {folder}")
+    d = 100e-6
+    print("| feed | rolling | alpha | angle per seed [deg] | mean [deg] | spread [deg] | resolution [deg] "
+          "| at rest per seed [mg] | wall time per seed [s] |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    means = {}
+    for key in sorted(runs, key=lambda k: (k[0] != "heap", k[1], k[2])):
+        feed, rolling, alpha = key
+        seeds = sorted(runs[key])
+        angles = [a for _, a, _, _ in seeds if a is not None]
+        mean = sum(angles) / len(angles) if angles else float("nan")
+        means[key] = mean
+        res = math.degrees(math.atan(alpha * d / PLATE_R))
+        print(f"| {'gas' if feed == 'heap' else 'still air'} | {rolling} | {alpha} "
+              f"| {', '.join('–' if a is None else f'{a:.1f}' for _, a, _, _ in seeds)} | {mean:.1f} "
+              f"| {(max(angles) - min(angles)) if angles else float('nan'):.1f} | {res:.1f} "
+              f"| {', '.join(f'{m * 1e6:.0f}' for _, _, m, _ in seeds)} "
+              f"| {', '.join(f'{w:.0f}' for _, _, _, w in seeds)} |")
+    print()
+    for feed in ("heap", "still"):
+        sd = {a: means[(f, r, a)] for (f, r, a) in means if f == feed and r == "sd"}
+        none = {a: means[(f, r, a)] for (f, r, a) in means if f == feed and r == "none"}
+        where = "gas" if feed == "heap" else "still air"
+        if 4 in sd and len(sd) > 1:
+            worst = max(abs(v / sd[4] - 1.0) for v in sd.values())
+            print(f"- {where}, S-D: largest departure from the alpha = 4 angle {worst:.1%} "
+                  f"({'within' if worst <= 0.10 else 'beyond'} 10 %)")
+        if 4 in none and 8 in none:
+            res8 = math.degrees(math.atan(8 * d / PLATE_R))
+            drop = none[4] - none[8]
+            print(f"- {where}, none: alpha = 4 -> 8 the angle changes by {-drop:+.1f} deg "
+                  f"({'falls by more than' if drop > res8 else 'does not fall by more than'} the alpha = 8 "
+                  f"resolution, {res8:.1f} deg)")
 
 
 def main():
@@ -154,6 +212,8 @@ def main():
         profile(sys.argv[2], sys.argv[3:])
     elif len(sys.argv) >= 3 and sys.argv[1] == "table":
         table(sys.argv[2:])
+    elif len(sys.argv) == 3 and sys.argv[1] == "heaps":
+        heaps(sys.argv[2])
     else:
         sys.exit(__doc__)
 

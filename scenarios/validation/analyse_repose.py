@@ -6,7 +6,7 @@ scenario name without its _s<seed> suffix) and prints, per variant, the angle of
 range, and the median |omega| of the mobile particles at the end (a measure of how static the heap is).
 
 With --curve PNG it also plots the theta_c -> angle-of-repose curve of the repose_sd_tc<DEG> variants (0 means no
-rolling resistance): every seed as a dot, the median as a line, and a horizontal band for each --band LABEL=LO:HI
+rolling resistance; the repose_<material>_sd_tc<DEG> variants of make_repose.py --material as a curve of their own): every seed as a dot, the median as a line, and a horizontal band for each --band LABEL=LO:HI
 (for example the LIGGGHTS epsd2 range). Needs matplotlib for the plot only (Debian: python3-matplotlib).
 
 Usage:
@@ -40,8 +40,14 @@ def runs(folders):
 
 
 def theta_c(variant):
-    m = re.match(r"repose_sd_tc([0-9.]+)$", variant)
+    m = re.match(r"repose_(?:[a-z]+_)?sd_tc([0-9.]+)$", variant)
     return float(m.group(1)) if m else None
+
+
+def material(variant):
+    """The deck's material of a repose_sd_tc<DEG> variant: 'repose', or the name make_repose.py --material gave."""
+    m = re.match(r"repose_([a-z]+)_sd_tc[0-9.]+$", variant)
+    return m.group(1) if m else "repose"
 
 
 def main(argv=None):
@@ -92,11 +98,17 @@ def main(argv=None):
             print("analyse_repose.py: matplotlib is missing (apt-get install python3-matplotlib)", file=sys.stderr)
             return 2
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
-        for t, v in curve:
-            pts = [a for _, a, _, _ in variants[v] if a is not None]
-            ax.plot([t] * len(pts), pts, "o", color="tab:blue", alpha=0.5, ms=5)
-        ax.plot([t for t, _ in curve], [medians[v] for _, v in curve], "-", color="tab:blue",
-                label="domel sd_critical_angle, median of %d seeds (dots: each seed)" % len(seeds))
+        line_colors = iter(["tab:blue", "tab:brown", "tab:gray", "tab:olive"])
+        for mat in sorted({material(v) for _, v in curve}):
+            color = next(line_colors)
+            own = [(t, v) for t, v in curve if material(v) == mat]
+            for t, v in own:
+                pts = [a for _, a, _, _ in variants[v] if a is not None]
+                ax.plot([t] * len(pts), pts, "o", color=color, alpha=0.5, ms=5)
+            n = max(len(variants[v]) for _, v in own)
+            ax.plot([t for t, _ in own], [medians[v] for _, v in own], "-", color=color,
+                    label="domel sd_critical_angle%s, median of %d seed%s (dots: each seed)" % (
+                        "" if mat == "repose" else ", %s material" % mat, n, "" if n == 1 else "s"))
         colors = iter(["tab:orange", "tab:green", "tab:red", "tab:purple"])
         for band in args.band:
             label, _, rng = band.rpartition("=")

@@ -14,7 +14,12 @@ mu_r = 0.1 (Iwashita-Oda stiffness, no dashpot): the same model in both codes.
 With --theta-c DEG [DEG ...] it also writes repose_sd_tc<DEG>.json:
 sd_critical_angle at those critical angles (0 means no rolling resistance),
 for the theta_c -> angle-of-repose curve of docs/rolling.md.
-Usage: make_repose.py [seed] [--epsd-library PATH] [--theta-c DEG [DEG ...]]"""
+With --material chamber the contacts are those of the DEM-CFD chamber's glass
+beads (restitution 0.9, sliding friction 0.3; scenarios/fluid/make_chamber.py)
+instead of the repose deck's (0.5, 0.5), everything else the same, and the
+files are named repose_chamber_<tag>: the curve from which the chamber's
+theta_c is read (docs/validation/chamber.md).
+Usage: make_repose.py [seed] [--epsd-library PATH] [--theta-c DEG [DEG ...]] [--material repose|chamber]"""
 import json, math, os, sys
 
 D = 0.0028
@@ -22,13 +27,15 @@ SPACING = 1.02
 RC = 0.033
 # the scenarios' description: the deck, without the generator's options
 DECK = " ".join(__doc__.split("Rolling resistance:")[0].split()).replace("Writes repose_{sd,dct,none}.json: ", "", 1)
+# the bead-bead contact of each material the deck is made with: (restitution, sliding friction)
+MATERIALS = {"repose": (0.5, 0.5), "chamber": (0.9, 0.3)}
 
 
 def collapse_deck(name, description, rolling, seed, column_top, floor_region, parcel=D, rc=RC, box=(0.1, 0.1),
-                  plugins=None, remove_at=0.25, duration=1.25):
+                  plugins=None, remove_at=0.25, duration=1.25, contact=MATERIALS["repose"]):
     """A column of lattice spheres (d = D, constant SPACING parcel diameters) in a cylinder of radius rc, removed at
     remove_at, collapsing onto a floor of fixed spheres (floor_region) in a box of half-width box[0] and height
-    box[1]; the repose deck's material and contact laws. parcel is the diameter after coarse-graining (D at
+    box[1]; the repose deck's material and contact laws, contact = (restitution, friction). parcel is the diameter after coarse-graining (D at
     alpha = 1): it sets the column region's margins and the probe's base height."""
     a = SPACING * parcel
     return {
@@ -38,7 +45,7 @@ def collapse_deck(name, description, rolling, seed, column_top, floor_region, pa
         **({"plugins": list(plugins)} if plugins else {}),
         "gravity": [0, 0, -9.81],
         "materials": {"beads": {"density": 2500, "youngs_modulus": 5e6, "poisson_ratio": 0.3}},
-        "interactions": [{"materials": ["beads", "beads"], "restitution": 0.5, "friction": 0.5}],
+        "interactions": [{"materials": ["beads", "beads"], "restitution": contact[0], "friction": contact[1]}],
         "walls": [
             {"name": "box", "type": "box", "material": "beads", "min": [-box[0], -box[0], 0.0],
              "max": [box[0], box[0], box[1]], "open": ["zmax"]},
@@ -88,6 +95,17 @@ def main():
         if any(not 0.0 <= x < 90.0 for x in angles):
             sys.exit("make_repose.py: --theta-c angles must lie in [0, 90) degrees")
         del args[k:k + 1 + n]
+    material = "repose"
+    if "--material" in args:
+        k = args.index("--material")
+        if k + 1 >= len(args) or args[k + 1] not in MATERIALS:
+            sys.exit("make_repose.py: --material needs one of " + ", ".join(MATERIALS))
+        material = args[k + 1]
+        del args[k:k + 2]
+    prefix = "repose_" if material == "repose" else f"repose_{material}_"
+    restitution, friction = MATERIALS[material]
+    deck = DECK if material == "repose" else DECK.replace(
+        "S1 material)", f"S1 material; restitution {restitution}, friction {friction}: the DEM-CFD chamber's beads)")
 
     seed = int(args[0]) if args else 15485863
     suffix = f"_s{seed}" if args else ""
@@ -102,11 +120,11 @@ def main():
     if library:
         models["epsd2"] = {"model": "epsd", "rolling_friction": 0.1, "stiffness": "iwashita_oda", "dashpot": False}
     for tag, rolling in models.items():
-        doc = collapse_deck(f"repose_{tag}{suffix}", DECK + " Rolling resistance: " + json.dumps(rolling) + ".",
+        doc = collapse_deck(f"{prefix}{tag}{suffix}", deck + " Rolling resistance: " + json.dumps(rolling) + ".",
                             rolling, seed, column_top=16 * SPACING * D,
                             floor_region={"box": {"min": [-0.0953, -0.0953, 0.0], "max": [0.0953, 0.0953, D]}},
-                            plugins=[library] if tag == "epsd2" else None)
-        with open(f"repose_{tag}{suffix}.json", "w") as f:
+                            plugins=[library] if tag == "epsd2" else None, contact=(restitution, friction))
+        with open(f"{prefix}{tag}{suffix}.json", "w") as f:
             json.dump(doc, f, indent=2)
             f.write("\n")
 
