@@ -184,8 +184,9 @@ def heaps(folder):
         means[key] = mean
         res = math.degrees(math.atan(alpha * d / PLATE_R))
         print(f"| {'gas' if feed == 'heap' else 'still air'} | {rolling} | {alpha} "
-              f"| {', '.join('–' if a is None else f'{a:.1f}' for _, a, _, _ in seeds)} | {mean:.1f} "
-              f"| {(max(angles) - min(angles)) if angles else float('nan'):.1f} | {res:.1f} "
+              f"| {', '.join('–' if a is None else f'{a:.1f}' for _, a, _, _ in seeds)} "
+              f"| {f'{mean:.1f}' if angles else '– (no heap)'} "
+              f"| {f'{max(angles) - min(angles):.1f}' if angles else '–'} | {res:.1f} "
               f"| {', '.join(f'{m * 1e6:.0f}' for _, _, m, _ in seeds)} "
               f"| {', '.join(f'{w:.0f}' for _, _, _, w in seeds)} |")
     print()
@@ -193,16 +194,22 @@ def heaps(folder):
         sd = {a: means[(f, r, a)] for (f, r, a) in means if f == feed and r == "sd"}
         none = {a: means[(f, r, a)] for (f, r, a) in means if f == feed and r == "none"}
         where = "gas" if feed == "heap" else "still air"
+        if any(math.isnan(v) for v in list(sd.values()) + list(none.values())):
+            print(f"- {where}: no heap to fit at alpha = "
+                  f"{', '.join(f'{a} ({r})' for (f, r, a), v in sorted(means.items()) if f == feed and math.isnan(v))}")
         if 4 in sd and len(sd) > 1:
             worst = max(abs(v / sd[4] - 1.0) for v in sd.values())
             print(f"- {where}, S-D: largest departure from the alpha = 4 angle {worst:.1%} "
                   f"({'within' if worst <= 0.10 else 'beyond'} 10 %)")
-        if 4 in none and 8 in none:
+        if 4 in none and 8 in none and not math.isnan(none[4]):
             res8 = math.degrees(math.atan(8 * d / PLATE_R))
-            drop = none[4] - none[8]
-            print(f"- {where}, none: alpha = 4 -> 8 the angle changes by {-drop:+.1f} deg "
-                  f"({'falls by more than' if drop > res8 else 'does not fall by more than'} the alpha = 8 "
-                  f"resolution, {res8:.1f} deg)")
+            if math.isnan(none[8]):
+                print(f"- {where}, none: {none[4]:.1f} deg at alpha = 4, no heap left at alpha = 8 (falls)")
+            else:
+                drop = none[4] - none[8]
+                print(f"- {where}, none: alpha = 4 -> 8 the angle changes by {-drop:+.1f} deg "
+                      f"({'falls by more than' if drop > res8 else 'does not fall by more than'} the alpha = 8 "
+                      f"resolution, {res8:.1f} deg)")
 
 
 def main():
