@@ -165,6 +165,8 @@ def heaps(folder):
         if not m or not os.path.isfile(path):
             continue
         s = json.load(open(path))
+        if s.get("status") == "interrupted":
+            continue
         rows = list(csv.DictReader(open(os.path.join(folder, name, "probes.csv"))))
         angle = s.get("repose_angle_deg", {}).get("beads")
         runs.setdefault((m.group(1), m.group(3), int(m.group(2))), []).append(

@@ -31,7 +31,8 @@ case "$set_" in
   *) echo "run_chamber.sh: SET must be sieve or heaps, not '$set_'" >&2; exit 2 ;;
 esac
 for r in "${runs[@]}"; do
-  [ -f "$out/$r/summary.json" ] && continue
+  # a run stopped early (SIGTERM: "status": "interrupted") is made again
+  [ -f "$out/$r/summary.json" ] && ! grep -q '"status": "interrupted"' "$out/$r/summary.json" && continue
   echo "$r"
 done | xargs -r -P "$jobs" -I{} sh -c '"$0" run "$1" --out "$2/{}" --overwrite --threads 1 --quiet > "$2/{}.log" 2>&1 && echo "done: {}" || { echo "FAILED: {} (see $2/{}.log)"; exit 1; }' \
   "$domel" "$scen/chamber_{}.json" "$out"
