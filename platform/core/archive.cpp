@@ -98,6 +98,8 @@ void ArchiveReader::fail(const std::string& key, const std::string& what) const 
 }
 
 ArchiveReader::ArchiveReader(const std::filesystem::path& path) : path_(path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) fail("", "is a folder, not a checkpoint file");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail("", "cannot be opened");
   parse(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));

@@ -87,9 +87,18 @@ std::vector<double> read_ascii_stl(const std::filesystem::path& file, const std:
 }  // namespace
 
 std::vector<double> read_stl(const std::filesystem::path& file) {
+  // a folder opens as a stream on Linux and fails only when read, with an
+  // error of the C++ library that names neither the file nor the wall
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw MeshError("STL file " + quoted(file) + " is a folder, not a file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw MeshError("cannot open STL file " + quoted(file));
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes;
+  try {
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::exception& e) {
+    throw MeshError("cannot read STL file " + quoted(file) + ": " + e.what());
+  }
   if (bytes.size() >= 84) {
     uint32_t n = 0;
     std::memcpy(&n, bytes.data() + 80, 4);  // little-endian on every platform domel builds on

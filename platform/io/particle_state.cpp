@@ -70,7 +70,18 @@ void write_particle_state(const std::filesystem::path& path, const ParticleStore
   write_file_atomically(path, format_particle_state(store, subdomain, time, coarse_grain, materials));
 }
 
+namespace {
+/// A folder opens as a stream on Linux and fails only when read, with an
+/// error of the C++ library that names no file: refuse it by name first.
+void refuse_folder(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw std::runtime_error(path.string() + ": is a folder, not a particle state file");
+}
+}  // namespace
+
 std::size_t count_lines(const std::filesystem::path& path) {
+  refuse_folder(path);
   std::ifstream in(path, std::ios::binary);
   std::size_t lines = 0;
   char buf[1 << 16];
@@ -89,6 +100,7 @@ std::vector<ParticleStateRow> read_particle_state(const std::filesystem::path& p
 
 std::size_t for_each_particle_state_row(const std::filesystem::path& path,
                                         const std::function<void(const ParticleStateRow&)>& visit) {
+  refuse_folder(path);
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path.string() + ": cannot open the particle state file");
   std::size_t rows = 0;

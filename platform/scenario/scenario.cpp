@@ -843,6 +843,11 @@ struct OverflowLocator {
 };
 
 json read_json_file(const std::filesystem::path& file, std::vector<Diagnostic>& diags) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    diags.push_back({file.string(), "", "is a folder, not a scenario file", "name the scenario's .json file"});
+    return {};
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     diags.push_back({file.string(), "", "cannot open the scenario file", "check the path"});
