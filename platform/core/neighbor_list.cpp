@@ -185,6 +185,7 @@ void NeighborList::build(const ParticleStore& s, ThreadPool* pool, std::size_t o
   // particle; docs/performance.md, memory). Transient: the keys of the live
   // contacts and their table, the cell index and the entries of the threads
   // other than the first.
+  grown_ = 0.0;
   std::size_t live = 0;
   for (std::size_t k = 0; k < i.size(); ++k) live += touching[k] ? 1 : 0;
   // When no particle was added, removed or re-ordered since the last build
@@ -530,6 +531,9 @@ void NeighborList::fields(CheckpointFields& f) {
   f("stride", stride);
   double skin = skin_;
   f("skin", skin);
+  // the growth since the build, kept only while particles grow, so that a
+  // checkpoint of a run without growing particles keeps its earlier layout
+  if (f.loading() ? f.reader().has(f.prefix() + "grown") : grown_ != 0.0) f("grown", grown_);
   std::vector<double> periodic = periodic_record(box_);
   f("periodic", periodic);
   if (!f.loading()) return;

@@ -94,7 +94,17 @@ class NeighborList {
   const double* x0() const { return x0_.data(); }
   const double* y0() const { return y0_.data(); }
   const double* z0() const { return z0_.data(); }
-  double rebuild_displacement2() const { return 0.25 * skin_ * skin_; }
+  /// Half the skin less the growth since the build, squared; -1 (every
+  /// displacement is beyond it, so the next check rebuilds) once the growth
+  /// alone has used half the skin.
+  double rebuild_displacement2() const { return allowance2(0.5 * skin_); }
+  /// Particles that grow (Subdomain::grow) close gaps as displacements do: a
+  /// pair unlisted at the build, at least the skin apart, closes it by at
+  /// most twice the largest displacement plus twice the largest growth of a
+  /// radius, so the displacement that forces a rebuild is half the skin less
+  /// the growth since the build (`dr` is this step's largest growth).
+  void add_growth(double dr) { grown_ += dr; }
+  double grown() const { return grown_; }
 
   /// Two tiers (docs/performance.md): entries [0, near_size()) had a gap
   /// (distance minus radii) below near_gap() at the build, the rest at least
@@ -104,7 +114,7 @@ class NeighborList {
   /// needs the overlap screen. Within each tier entries keep build order.
   std::size_t near_size() const { return near_size_; }
   double near_gap() const { return kNearFraction * skin_; }
-  double far_tier_displacement2() const { return 0.25 * near_gap() * near_gap(); }
+  double far_tier_displacement2() const { return allowance2(0.5 * near_gap()); }
   static constexpr double kNearFraction = 0.5;
   /// Build from the store's positions; with a pool of several threads the
   /// scan over particles runs in parallel (the same list as on one thread).
@@ -145,7 +155,13 @@ class NeighborList {
   void for_each_periodic_pair(std::size_t a_first, std::size_t a_last, const int dim[3], const uint32_t* start,
                               const uint32_t* order, const double per[3], const double inv_per[3], CellOf&& cell_of,
                               const ParticleStore& s, double near_gap, Visit&& visit) const;
+  /// (half - grown)^2, or -1 once the growth has used `half`
+  double allowance2(double half) const {
+    const double h = half - grown_;
+    return h > 0 ? h * h : -1.0;
+  }
   double skin_ = 0.0;
+  double grown_ = 0.0;  ///< the largest radius growth since the build, summed over steps
   uint32_t stride_ = 0;
   PeriodicBox box_;
   std::size_t builds_ = 0;

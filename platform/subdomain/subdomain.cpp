@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstdint>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace domel::platform {
@@ -387,7 +389,96 @@ void Subdomain::synchronize() {
     if (bad != 0.0) throw_nonfinite("in the second half kick", time_, steps_);
 }
 
+void Subdomain::grow(std::size_t k, double to, double rate) {
+  synchronize();
+  if (k >= store_.size()) throw std::out_of_range("Subdomain::grow: no particle " + std::to_string(k));
+  if (!(to > 0) || !(rate > 0) || !std::isfinite(to) || !std::isfinite(rate))
+    throw std::invalid_argument("Subdomain::grow: the radius to grow to and the rate must be positive and finite");
+  enable_growth();
+  store_.aux[grow_to_][k] = to;
+  store_.aux[grow_rate_][k] = rate;
+  growing_ = growing_ || store_.radius[k] < to;
+}
+
+void Subdomain::enable_growth() {
+  if (grow_to_ != SIZE_MAX) return;
+  grow_to_ = store_.add_field("grow_to", ParticleStore::kCarried);
+  grow_rate_ = store_.add_field("grow_rate", ParticleStore::kCarried);
+}
+
+void Subdomain::find_growth() {
+  grow_to_ = grow_rate_ = SIZE_MAX;
+  const auto& names = store_.aux_names();
+  for (std::size_t a = 0; a < names.size(); ++a) {
+    if (names[a] == "grow_to") grow_to_ = a;
+    if (names[a] == "grow_rate") grow_rate_ = a;
+  }
+  growing_ = false;
+  if (grow_to_ == SIZE_MAX || grow_rate_ == SIZE_MAX) return;
+  for (std::size_t k = 0; k < store_.size() && !growing_; ++k) growing_ = store_.radius[k] < store_.aux[grow_to_][k];
+}
+
+void Subdomain::grow_step() {
+  // every particle of the store, ghosts included: a ghost carries its
+  // owner's target and rate and grows as the owner does, so the two stay equal
+  // between builds without an exchange
+  const double* to = store_.aux[grow_to_].data();
+  const double* rate = store_.aux[grow_rate_].data();
+  double* r = store_.radius.data();
+  const std::size_t n = store_.size();
+  // each particle's largest overlap with a pair partner now: one that
+  // presses into its neighbours by more than grow_overlap_ of its diameter
+  // waits for them to make room (a packing grown faster than it can
+  // rearrange jams and then bursts)
+  overlap_.assign(n, 0.0);
+  if (grow_overlap_ > 0) {
+    double L[3], inv_L[3];
+    nlist_.periodic().periods(L, inv_L);
+    for (std::size_t e = 0; e < nlist_.size(); ++e) {
+      const std::uint32_t i = nlist_.i[e], j = nlist_.j[e];
+      if (i >= n || j >= n) continue;
+      const double dx = min_image(store_.x[i] - store_.x[j], L[0], inv_L[0]);
+      const double dy = min_image(store_.y[i] - store_.y[j], L[1], inv_L[1]);
+      const double dz = min_image(store_.z[i] - store_.z[j], L[2], inv_L[2]);
+      const double ov = r[i] + r[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
+      overlap_[i] = std::max(overlap_[i], ov);
+      overlap_[j] = std::max(overlap_[j], ov);
+    }
+    // and with the walls their lists name (a mesh's triangles are left out: its overlaps with a growing
+    // particle also press the particle's pair partners, which the pairs above see)
+    for (std::size_t w = 0; w < wall_lists_.size(); ++w) {
+      const WallPrimitive& wall = walls_now_[w];
+      if (!wall_lists_[w].built || wall.shape == WallPrimitive::Shape::mesh) continue;
+      for (std::uint32_t q : wall_lists_[w].particle) {
+        if (q >= n) continue;
+        double d, nx, ny, nz;
+        if (wall.gap(store_.x[q], store_.y[q], store_.z[q], d, nx, ny, nz)) overlap_[q] = std::max(overlap_[q], r[q] - d);
+      }
+    }
+  }
+  double most = 0;
+  bool left = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!(r[k] < to[k])) continue;
+    if (grow_overlap_ > 0 && overlap_[k] > grow_overlap_ * 2 * to[k]) {
+      left = true;
+      continue;
+    }
+    const double next = std::min(to[k], r[k] + rate[k] * dt_);
+    most = std::max(most, next - r[k]);
+    r[k] = next;
+    left = left || next < to[k];
+  }
+  nlist_.add_growth(most);
+  growing_ = left;
+}
+
 void Subdomain::step_deferred() {
+  if (growing_) {
+    // the last step's deferred work (with threads: its wall contacts) at the radii it ended with
+    synchronize();
+    grow_step();
+  }
   // the fused step owns every particle of the store; a rank completes its
   // step in phase order, the exchanges between them
   if (hooks_.empty() && !ranks_->over_ranks()) step_fused();

@@ -166,6 +166,29 @@ class Subdomain {
   /// half kick sees the same forces as every other particle's.
   void apply_body_forces(std::size_t first, std::size_t last);
 
+  /// Particle k (an index into store()) was placed smaller than its own
+  /// size, as a conversion between levels places its particles
+  /// (coupling/conversion.hpp, docs/adaptive.md): from the next step on its
+  /// radius grows by rate [m/s] times the time step at the start of every
+  /// step until it reaches `to`; its mass and inertia should be those of
+  /// `to` already. The neighbour lists count the growth as they count
+  /// displacements (NeighborList::add_growth), so no contact is missed.
+  /// The targets and rates are two per-particle fields ("grow_to",
+  /// "grow_rate"), added at the first call, carried and checkpointed.
+  void grow(std::size_t k, double to, double rate);
+  /// Add the two growth fields now (idempotent; grow() does at its first
+  /// call): a run whose particles may grow calls it at set-up, so that a
+  /// checkpoint written with them is read into a store that has them.
+  void enable_growth();
+  /// Whether some particle is still growing.
+  bool growing() const { return growing_; }
+  /// A growing particle whose overlap with a pair partner or a wall (of
+  /// every kind but meshes) exceeds this fraction of its full diameter waits
+  /// that step for its neighbours to make room; 0: it never waits. Default
+  /// 0.01: grown at a fixed rate alone, a refined packing jams and bursts
+  /// (docs/adaptive.md has the figures).
+  void set_growth_overlap(double fraction) { grow_overlap_ = fraction; }
+
   /// Register a hook on a phase of every following step (step_phases.hpp).
   /// From then on each step completes in phase order.
   void add_hook(Phase phase, StepHook hook);
@@ -280,6 +303,10 @@ class Subdomain {
   void finish_wall_stats();
   [[noreturn]] void throw_nonfinite(const char* when, double t, std::uint64_t step) const;
   void prune_removed_walls();
+  /// The growth of this step (grow()), before its drift; clears growing_ when none is left.
+  void grow_step();
+  /// After a checkpoint's particles were loaded: the growth fields, if any, and whether any particle grows.
+  void find_growth();
 
   std::string name_;
   double coarse_grain_;
@@ -339,6 +366,10 @@ class Subdomain {
   std::size_t ghosts_end_ = 0;  ///< the store's size after the ghosts were built
   bool edited_ = false;         ///< particles_to_edit() dropped ghosts that the lists name
   bool elsewhere_ = false;      ///< set_elsewhere()
+  bool growing_ = false;        ///< some particle's radius is below its grow_to (grow())
+  std::size_t grow_to_ = SIZE_MAX, grow_rate_ = SIZE_MAX;  ///< their aux fields, once added
+  double grow_overlap_ = 0.01;  ///< set_growth_overlap()
+  std::vector<double> overlap_;  ///< grow_step()'s scratch
 };
 
 }  // namespace domel::platform

@@ -206,6 +206,7 @@ std::size_t Subdomain::load_state(const ArchiveReader& r, const std::string& p, 
   kick_pending_ = false;
   reduce_pending_ = false;
   contacts_counted_ = true;
+  find_growth();
   return own;
 }
 

@@ -151,6 +151,34 @@ TEST(NeighborList, RebuildsOnlyAfterHalfSkinDisplacement) {
   EXPECT_TRUE(nl.needs_rebuild(s));
 }
 
+// Growing radii close gaps as displacements do: the displacement that forces a rebuild is half the skin less the
+// growth since the build, and growth alone past half the skin forces one. The case: two spheres the skin plus a
+// little apart, so unlisted; one grows and the other moves towards it, each within half the skin, together past it.
+TEST(NeighborList, GrowthSinceTheBuildCountsAgainstTheSkin) {
+  ParticleStore s;
+  const double r = 0.001, skin = 0.0004;
+  s.add(1, 0, 0, 0, r, 2500);
+  s.add(2, 2 * r + skin * 1.01, 0, 0, r, 2500);
+  NeighborList nl;
+  nl.configure(skin, 0);
+  nl.build(s);
+  EXPECT_EQ(nl.size(), 0u);
+  s.radius[0] += 0.3 * skin;  // the grown particle reaches 0.3 skin further
+  nl.add_growth(0.3 * skin);
+  s.x[1] -= 0.3 * skin;  // and the other moved 0.3 skin towards it: 0.6 skin closed, contact possible soon
+  EXPECT_TRUE(nl.needs_rebuild(s)) << "0.3 skin of growth leaves 0.2 skin of displacement";
+  s.x[1] += 0.15 * skin;  // back to 0.15 skin moved: within the 0.2 left
+  EXPECT_FALSE(nl.needs_rebuild(s));
+  nl.add_growth(0.25 * skin);  // 0.55 skin grown: more than half the skin by growth alone
+  s.x[1] += 0.15 * skin;       // even at rest
+  EXPECT_TRUE(nl.needs_rebuild(s));
+  EXPECT_LT(nl.far_tier_displacement2(), 0.0);
+  nl.build(s);  // a build starts the count again
+  EXPECT_EQ(nl.grown(), 0.0);
+  EXPECT_FALSE(nl.needs_rebuild(s));
+  EXPECT_EQ(nl.rebuild_displacement2(), 0.25 * skin * skin);
+}
+
 TEST(NeighborList, HistorySurvivesRebuildAndReordering) {
   ParticleStore s = cloud(400, 11);
   NeighborList nl;
