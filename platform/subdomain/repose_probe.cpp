@@ -29,10 +29,14 @@ std::optional<double> repose_angle(const ParticleStore& s, const ReposeProbeSett
   if (settings.planar && settings.crest) (settings.axis == 0 ? xc : yc) = *settings.crest;
   const double cs = settings.cell * dsum / n;
   std::map<std::pair<long, long>, double> top;
+  // a cell index beyond what a key holds (a crest 1e300 m away: the run-time
+  // fuzzer) has no place in the fit; converting it would be undefined
+  constexpr double kMaxCell = 1e18;
   for (std::size_t k = 0; k < s.size(); ++k) {
     if (!counted(k)) continue;
-    const std::pair<long, long> key{static_cast<long>(std::floor((s.x[k] - xc) / cs)),
-                                    static_cast<long>(std::floor((s.y[k] - yc) / cs))};
+    const double qx = std::floor((s.x[k] - xc) / cs), qy = std::floor((s.y[k] - yc) / cs);
+    if (!(std::abs(qx) < kMaxCell && std::abs(qy) < kMaxCell)) continue;
+    const std::pair<long, long> key{static_cast<long>(qx), static_cast<long>(qy)};
     const double h = s.z[k] + s.radius[k] - settings.base_height;
     auto it = top.find(key);
     if (it == top.end() || h > it->second) top[key] = h;

@@ -93,6 +93,22 @@ TEST(ReposeProbe, HalfPlanarHeapMeasuredFromItsCrestLine) {
   EXPECT_NEAR(*a, theta, tolerance(theta));
 }
 
+// A crest line so far away that no cell index can hold the distance (1e300 m: run-time fuzzing start 12, where
+// the conversion to an integer key was undefined) leaves nothing to fit: no angle, and no undefined behaviour
+// (the sanitized build checks that).
+TEST(ReposeProbe, ACrestBeyondAnyCellGivesNoAngle) {
+  const double theta = 25.0, h = kHeight, wall = 0.01;
+  const auto s = stack(wall, wall + foot(theta), 0.0, 10 * kD, [&](double x, double) {
+    return h - (x - wall) * tand(theta);
+  });
+  ReposeProbeSettings p;
+  p.planar = true;
+  for (double crest : {1e300, -1e300, 1e30}) {
+    p.crest = crest;
+    EXPECT_FALSE(repose_angle(s, p).has_value()) << crest;
+  }
+}
+
 TEST(ReposeProbe, BaseHeightAndBandSelectTheFittedPart) {
   // A cone on a 10 mm bed of particles: base_height at the bed's top keeps the bed out of the band.
   const double theta = 20.0, floor = 0.01, h = kHeight, e = foot(theta);
