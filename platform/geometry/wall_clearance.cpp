@@ -57,28 +57,6 @@ double WallClearance::overlap(const double p[3], double r, std::size_t* which) c
     } else {
       double nx, ny, nz;
       touches = w.gap(p[0], p[1], p[2], d, nx, ny, nz);
-      if (w.shape == WallPrimitive::Shape::cone_inside) {
-        // Beside a frustum, within its axial extent and outside its mantle, a
-        // point is behind the container's wall however far out it lies. The
-        // kernels' distance there is the rim's, unsigned (an edge contact
-        // from any side), which called such a point clear: an insertion
-        // region wider than a hopper placed particles around it (run-time
-        // fuzzing start 13), and one that moved into the mantle's interior
-        // zone was then centimetres inside the wall with no contact.
-        const double s = p[w.axis];
-        double rr = 0;
-        for (int a = 0; a < 3; ++a)
-          if (a != static_cast<int>(w.axis)) rr += (p[a] - w.c[a]) * (p[a] - w.c[a]);
-        const double ts = w.hi - w.lo, tr = w.radius_hi - w.radius;
-        if (ts > 0 && s >= w.lo && s <= w.hi) {
-          const double at = w.radius + tr * (s - w.lo) / ts, rho = std::sqrt(rr);
-          if (rho > at) {
-            const double behind = (rho - at) * ts / std::sqrt(tr * tr + ts * ts);  // the distance to the mantle
-            if (!touches || -behind < d) d = -behind;
-            touches = true;
-          }
-        }
-      }
     }
     if (touches && r - d > deepest) {
       deepest = r - d;
