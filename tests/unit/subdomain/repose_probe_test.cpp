@@ -78,13 +78,18 @@ TEST(ReposeProbe, SymmetricPlanarHeapAlongEitherAxis) {
   }
 }
 
+// Half a planar heap of slope theta leaning on a wall at x = wall.
+ParticleStore half_heap(double theta, double wall) {
+  return stack(wall, wall + foot(theta), 0.0, 10 * kD, [&](double x, double) {
+    return kHeight - (x - wall) * tand(theta);
+  });
+}
+
 TEST(ReposeProbe, HalfPlanarHeapMeasuredFromItsCrestLine) {
   // Half a heap leaning on a wall at x = 0.01 m: its centroid lies a third of the way down the slope, so the crest
   // line is given (the wall).
-  const double theta = 25.0, h = kHeight, wall = 0.01;
-  const auto s = stack(wall, wall + foot(theta), 0.0, 10 * kD, [&](double x, double) {
-    return h - (x - wall) * tand(theta);
-  });
+  const double theta = 25.0, wall = 0.01;
+  const auto s = half_heap(theta, wall);
   ReposeProbeSettings p;
   p.planar = true;
   p.crest = wall;
@@ -97,10 +102,7 @@ TEST(ReposeProbe, HalfPlanarHeapMeasuredFromItsCrestLine) {
 // the conversion to an integer key was undefined) leaves nothing to fit: no angle, and no undefined behaviour
 // (the sanitized build checks that).
 TEST(ReposeProbe, ACrestBeyondAnyCellGivesNoAngle) {
-  const double theta = 25.0, h = kHeight, wall = 0.01;
-  const auto s = stack(wall, wall + foot(theta), 0.0, 10 * kD, [&](double x, double) {
-    return h - (x - wall) * tand(theta);
-  });
+  const auto s = half_heap(25.0, 0.01);
   ReposeProbeSettings p;
   p.planar = true;
   for (double crest : {1e300, -1e300, 1e30}) {
