@@ -166,12 +166,18 @@ struct WallPrimitive {
     return false;
   }
 
-  /// Frustum mantle. In the half-plane (rho, s) through the axis and the
-  /// point, the mantle is the segment from (radius, lo) to (radius_hi, hi);
-  /// the contact point is the closest point of that segment (a point
-  /// projected past an end meets the rim circle: an edge contact, normal
-  /// from the rim to the centre, from any side). On the segment's interior
-  /// the distance is signed, positive on the axis side.
+  /// Frustum mantle, a container like the cylinder: the wall is solid
+  /// behind the mantle within its axial extent, i.e. where lo <= s <= hi and
+  /// rho > R(s), the mantle's radius there. In the half-plane (rho, s)
+  /// through the axis and the point, the mantle is the segment from
+  /// (radius, lo) to (radius_hi, hi) and the contact point is the segment's
+  /// closest point: on its interior a face contact along the segment's
+  /// inward normal, past an end the rim circle (an edge contact, from any
+  /// side outside the solid). The distance is that to the closest point,
+  /// negative in the solid, so it is continuous everywhere but across the
+  /// solid's ends beside the mantle (s = lo or hi, rho beyond the rim),
+  /// where a cylinder's jumps too; near() keeps the points that can cross
+  /// them. Returns false only on the rim circle itself.
   bool cone_gap(double x, double y, double z, double& d, double& nx, double& ny, double& nz) const {
     const double q[3] = {x - c[0], y - c[1], z - c[2]};
     const double s = (axis == 0 ? x : axis == 1 ? y : z);
@@ -186,13 +192,19 @@ struct WallPrimitive {
     }
     const double tr = radius_hi - radius, ts = hi - lo;
     const double len2 = tr * tr + ts * ts;
+    const double len = std::sqrt(len2);
+    const double mr = -ts / len, ms = tr / len;  // inward unit normal of the segment
+    const double across = (rho - radius) * mr + (s - lo) * ms;  // signed distance from the segment's line
+    const bool solid = across < 0.0 && s >= lo && s <= hi;       // behind the mantle within its extent
     double u = ((rho - radius) * tr + (s - lo) * ts) / len2;
-    double dr, ds;  // point minus closest point, in (rho, s)
+    double dr, ds;  // unit direction from the closest point to the point, in (rho, s)
     if (u > 0.0 && u < 1.0) {
-      const double len = std::sqrt(len2);
-      const double mr = -ts / len, ms = tr / len;  // inward unit normal of the segment
-      d = (rho - radius) * mr + (s - lo) * ms;
+      d = across;
       dr = mr; ds = ms;
+      if (d < 0.0 && !solid) {  // behind the line beyond the extent (under a flat funnel): the outer face
+        d = -d;
+        dr = -mr; ds = -ms;
+      }
     } else {
       u = u <= 0.0 ? 0.0 : 1.0;
       dr = rho - (radius + u * tr);
@@ -200,6 +212,10 @@ struct WallPrimitive {
       d = std::sqrt(dr * dr + ds * ds);
       if (d <= 0.0) return false;
       dr /= d; ds /= d;
+      if (solid) {  // in the solid, its nearest surface point is the rim: pushed towards it
+        d = -d;
+        dr = -dr; ds = -ds;
+      }
     }
     double nv[3] = {dr * er[0], dr * er[1], dr * er[2]};
     nv[axis] += ds;
@@ -267,9 +283,22 @@ struct WallPrimitive {
         if (rho > r_outer + reach) return false;
         return gap(x, y, z, d, nx, ny, nz) && d < reach;
       }
-      case Shape::cone_inside:
-        if (gap(x, y, z, d, nx, ny, nz)) return d < reach;
-        return true;  // on the axis: keep it (rare, cheap)
+      case Shape::cone_inside: {
+        if (!gap(x, y, z, d, nx, ny, nz)) return true;  // on the rim circle: keep it (rare, cheap)
+        if (d < reach) return true;
+        // a point that can step into the solid behind the mantle (across its
+        // ends, where the distance jumps) within `reach`: near the extent and
+        // within reach of the segment's line (both move at most as far as
+        // the point)
+        const double s = (axis == 0 ? x : axis == 1 ? y : z);
+        if (s < lo - reach || s > hi + reach) return false;
+        double r[3] = {x - c[0], y - c[1], z - c[2]};
+        r[axis] = 0.0;
+        const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        const double tr = radius_hi - radius, ts = hi - lo;
+        const double across = ((rho - radius) * -ts + (s - lo) * tr) / std::sqrt(tr * tr + ts * ts);
+        return across < reach;
+      }
       default: return gap(x, y, z, d, nx, ny, nz) && d < reach;
     }
   }

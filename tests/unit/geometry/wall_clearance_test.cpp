@@ -243,3 +243,25 @@ TEST(WallClearance, AnInsertionReachingPastAHopperConePlacesNothingInIt) {
   std::printf("[hopper insertion] %zu particles, least clearance from the cone %.3g radii\n", s.size(), closest);
   EXPECT_GE(closest, -1e-9);  // round-off of the two distance formulas
 }
+
+TEST(WallClearance, AnInsertionBoxWiderThanAHopperPlacesNothingBesideIt) {
+  // Fuzzing start 13: a box wider than the hopper placed 13 of 14 particles
+  // around the cone, where the mantle's closest point is a rim and the
+  // distance used to be the rim's, unsigned: clear. Beside the mantle within
+  // its extent is the container's solid, so every particle placed from a box
+  // three times the hopper's width and as tall as it lies inside the cone.
+  nlohmann::json doc = hopper_reached_through();
+  doc["subdomains"][0]["insert"] = {{{"model", "random"}, {"diameter", 0.0014}, {"count", 400}, {"seed", 3},
+                                     {"region", {{"box", {{"min", {-0.03, -0.03, 0.005}}, {"max", {0.03, 0.03, kH}}}}}}}};
+  const auto sim = dt::build(doc);
+  const dp::ParticleStore& s = sim->subdomains[0]->store();
+  ASSERT_GT(s.size(), 20u);
+  std::size_t beside = 0;
+  for (std::size_t k = 0; k < s.size(); ++k)
+    beside += std::hypot(s.x[k], s.y[k]) > kR0 + (kR1 - kR0) * s.z[k] / kH ? 1 : 0;
+  const double closest = least_cone_clearance(s);
+  std::printf("[hopper in a wide box] %zu particles, %zu beside the cone, least clearance %.3g radii\n", s.size(),
+              beside, closest);
+  EXPECT_EQ(beside, 0u);
+  EXPECT_GE(closest, -1e-9);
+}

@@ -84,6 +84,83 @@ TEST(ConeWall, MantleFaceAndRimEdges) {
   EXPECT_NEAR(ny, my, 1e-15);
 }
 
+TEST(ConeWall, TheSolidBehindTheMantleWithinItsExtent) {
+  // The hopper of MantleFaceAndRimEdges. Behind the mantle within the extent
+  // the wall is solid everywhere, also where the mantle's closest point is a
+  // rim (fuzzing start 13 found particles there counted clear, 25 mm deep a
+  // step later): the distance is minus that to the rim, the normal towards it.
+  dp::WallPrimitive c;
+  c.shape = dp::WallPrimitive::Shape::cone_inside;
+  c.axis = 2;
+  c.radius = 0.1;
+  c.radius_hi = 0.4;
+  c.lo = 0.0;
+  c.hi = 0.3;
+  double d, nx, ny, nz;
+  const double s2 = std::sqrt(0.5);
+  // rho 0.6 at z = 0.25: the top rim (0.4, 0.3) is closest; distance hypot(0.2, 0.05)
+  ASSERT_TRUE(c.gap(0.6, 0.0, 0.25, d, nx, ny, nz));
+  const double h = std::hypot(0.2, 0.05);
+  EXPECT_NEAR(d, -h, 1e-14);
+  EXPECT_NEAR(nx, -0.2 / h, 1e-14);
+  EXPECT_NEAR(nz, 0.05 / h, 1e-14);
+  // the same rho just above the top: outside the solid, the rim's distance, positive
+  ASSERT_TRUE(c.gap(0.6, 0.0, 0.31, d, nx, ny, nz));
+  EXPECT_NEAR(d, std::hypot(0.2, 0.01), 1e-14);
+  EXPECT_NEAR(nx, 0.2 / std::hypot(0.2, 0.01), 1e-14);
+  // continuous across the edge of the face's band behind the mantle: the
+  // line through the top rim along the outward normal (1, -1)/sqrt 2
+  const double e = 1e-9;
+  double d_in, d_out;
+  ASSERT_TRUE(c.gap(0.4 + 0.05 - e, 0.0, 0.3 - 0.05 - e, d_in, nx, ny, nz));   // in the face's band
+  ASSERT_TRUE(c.gap(0.4 + 0.05 + e, 0.0, 0.3 - 0.05 + e, d_out, nx, ny, nz));  // the rim's zone
+  EXPECT_NEAR(d_in, -0.05 / s2, 1e-8);
+  EXPECT_NEAR(d_out, -0.05 / s2, 1e-8);
+  // beside and below the lower end: outside the extent, the underside of the
+  // funnel (the outer face, normal outwards and down) or the lower rim
+  ASSERT_TRUE(c.gap(0.3, 0.0, -0.01, d, nx, ny, nz));
+  EXPECT_NEAR(d, (0.2 + 0.01) * s2, 1e-14);
+  EXPECT_NEAR(nx, s2, 1e-14);
+  EXPECT_NEAR(nz, -s2, 1e-14);
+  ASSERT_TRUE(c.gap(0.15, 0.0, -0.1, d, nx, ny, nz));
+  EXPECT_NEAR(d, std::hypot(0.05, 0.1), 1e-14);
+  EXPECT_NEAR(nz, -0.1 / std::hypot(0.05, 0.1), 1e-14);
+  // a flat funnel (radius 0.01 at z = 0 to 0.1 at z = 0.01): a point 1 mm
+  // under it past its lower end sees the underside (the outer face), not the solid
+  dp::WallPrimitive f = c;
+  f.radius = 0.01;
+  f.radius_hi = 0.1;
+  f.hi = 0.01;
+  ASSERT_TRUE(f.gap(0.06, 0.0, -0.001, d, nx, ny, nz));
+  const double len = std::hypot(0.09, 0.01);
+  const double across = ((0.06 - 0.01) * -0.01 + -0.001 * 0.09) / len;  // < 0: behind the line
+  EXPECT_NEAR(d, -across, 1e-15);
+  EXPECT_NEAR(nx, 0.01 / len, 1e-15);   // the outward normal: away from the funnel, down
+  EXPECT_NEAR(nz, -0.09 / len, 1e-15);
+  // ... and 1 mm higher it is within the extent: in the solid
+  ASSERT_TRUE(f.gap(0.06, 0.0, 0.0005, d, nx, ny, nz));
+  EXPECT_LT(d, 0.0);
+}
+
+TEST(ConeWall, AListCandidateWhereverItCanStepIntoTheSolid) {
+  dp::WallPrimitive c;
+  c.shape = dp::WallPrimitive::Shape::cone_inside;
+  c.axis = 2;
+  c.radius = 0.1;
+  c.radius_hi = 0.4;
+  c.lo = 0.0;
+  c.hi = 0.3;
+  // 0.2 beside the top rim, 1 mm above the extent: 0.2 from the wall, but
+  // 2 mm down it is 0.2 deep in it, so a candidate at a reach of 2 mm
+  EXPECT_TRUE(c.near(0.6, 0.0, 0.301, 0.002));
+  EXPECT_FALSE(c.near(0.6, 0.0, 0.304, 0.002));  // 4 mm above: out of reach of the extent
+  // inside the hopper, far from the mantle and its line: no candidate
+  EXPECT_FALSE(c.near(0.0, 0.0, 0.29, 0.002));
+  EXPECT_FALSE(c.near(0.0, 0.0, 0.31, 0.002));
+  // in the solid: always
+  EXPECT_TRUE(c.near(5.0, 0.0, 0.2, 0.002));
+}
+
 TEST(WallMotion, PlaceAndSurfaceVelocity) {
   dp::WallPrimitive base;
   base.shape = dp::WallPrimitive::Shape::plane;
