@@ -14,6 +14,7 @@
 
 #include "core/archive.hpp"
 #include "core/error.hpp"
+#include "coupling/conversion.hpp"
 #include "geometry/wall_clearance.hpp"
 #include "io/cell_grid_output.hpp"
 #include "io/csv_series.hpp"
@@ -25,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -124,6 +126,127 @@ void Coupling::start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const 
     vtk_coarse_ = std::make_unique<io::CellGridVtkSeries>(out, spec_.name + "_coarse");
     grid_files_ = Cadence::in_time(spec_.grid_interval, spec_.grid_interval, macro_step_of(subdomains));
   }
+}
+
+void Coupling::fit_in_region(const ConvertedBody& parcel, std::vector<ConvertedBody>& made) const {
+  // A parcel whose centre lies within the children's reach of a face would
+  // have children beyond it, which the next exchange removes as escaped.
+  // Such a cluster is shrunk by s about its centre and moved inwards by d
+  // (per axis), the least shrinking for which every child's centre is in the
+  // region and the cluster still lies inside the parcel's sphere (|d| <= (1 -
+  // s) R), so it touches nothing the parcel did not. Velocities stay as made.
+  const CellGridSpec& g = spec_.grid;
+  const double* X = parcel.x;
+  const double R = parcel.radius;
+  double reach = 0;
+  for (const ConvertedBody& b : made)
+    reach = std::max(reach, std::hypot(b.x[0] - X[0], b.x[1] - X[1], b.x[2] - X[2]));
+  auto shift = [&](double s, double d[3]) {
+    double n2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double out_hi = X[a] + s * reach - g.hi[a], out_lo = g.lo[a] - (X[a] - s * reach);
+      d[a] = (out_hi > 0 ? -out_hi : 0.0) + (out_lo > 0 ? out_lo : 0.0);
+      n2 += d[a] * d[a];
+    }
+    return std::sqrt(n2);
+  };
+  double d[3];
+  if (shift(1.0, d) == 0.0) return;
+  double lo = 0.0, hi = 1.0;  // lo is feasible: a point at X
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (shift(mid, d) <= (1.0 - mid) * R ? lo : hi) = mid;
+  }
+  const double s = lo;
+  shift(s, d);
+  for (ConvertedBody& b : made) {
+    for (int a = 0; a < 3; ++a) b.x[a] = X[a] + d[a] + s * (b.x[a] - X[a]);
+    b.start_radius *= s;
+  }
+}
+
+void Coupling::refine_at_start(std::vector<std::unique_ptr<Subdomain>>& subdomains, ParticleFlow& flow) {
+  Subdomain& fine = *subdomains[spec_.fine];
+  Subdomain& coarse = *subdomains[spec_.coarse];
+  // the whole sets, the same on every rank, so that every rank makes the
+  // same particles and keeps its own (as a transfer does)
+  GatheredParticles all_f = ranks_->gather(fine, true);
+  ParticleStore& f = *all_f;
+  if (f.size() > 0) return;  // the fine level brings its own material for the region
+  GatheredParticles all_c = ranks_->gather(coarse, true);
+  const ParticleStore& c = *all_c;
+  std::vector<std::size_t> inside;
+  for (std::size_t q = 0; q < c.size(); ++q)
+    if (inside_box(spec_.grid, c.x[q], c.y[q], c.z[q])) inside.push_back(q);
+  if (inside.empty()) return;
+  std::sort(inside.begin(), inside.end(), [&](std::size_t a, std::size_t b) { return c.id[a] < c.id[b]; });
+  // a parcel still growing (refined just now from a coarser level) is refined at its own size
+  std::size_t grow_to = SIZE_MAX;
+  for (std::size_t a = 0; a < c.aux_names().size(); ++a)
+    if (c.aux_names()[a] == "grow_to") grow_to = a;
+  auto full_radius = [&](std::size_t q) {
+    return grow_to != SIZE_MAX ? std::max(c.radius[q], c.aux[grow_to][q]) : c.radius[q];
+  };
+  fine.enable_growth();  // on every rank: the fields travel with ghosts whether or not this rank keeps a particle
+  const double growth_time = spec_.growth_steps * fine.time_step();
+  std::map<double, CarriedMass> carried;  // per parcel radius: a kind of fine particle
+  ConversionBooks books;
+  std::vector<ConvertedBody> made;
+  std::unordered_map<std::uint64_t, std::pair<double, double>> growth;  // id -> radius to grow to, rate
+  const std::size_t first = f.size();
+  for (std::size_t q : inside) {
+    ConvertedBody p;
+    p.x[0] = c.x[q], p.x[1] = c.y[q], p.x[2] = c.z[q];
+    p.v[0] = c.vx[q], p.v[1] = c.vy[q], p.v[2] = c.vz[q];
+    p.w[0] = c.wx[q], p.w[1] = c.wy[q], p.w[2] = c.wz[q];
+    p.radius = full_radius(q);
+    p.mass = c.mass[q];
+    refined_.parcel_units += mass_units(p.mass);
+    const double rf = p.radius * spec_.alpha_ratio;
+    // the particle store's own mass of a sphere (ParticleStore::add), so that the books are the store's
+    const double mf = spec_.fine_density * 4.0 / 3.0 * M_PI * rf * rf * rf;
+    made.clear();
+    refine_parcel(p, rf, mf, carried[p.radius], rng_, made, books);
+    fit_in_region(p, made);
+    for (const ConvertedBody& b : made) {
+      const std::uint64_t id = flow.next_id++;
+      f.add(id, b.x[0], b.x[1], b.x[2], rf, spec_.fine_density, false);
+      const std::size_t k = f.size() - 1;
+      f.vx[k] = b.v[0], f.vy[k] = b.v[1], f.vz[k] = b.v[2];
+      f.wx[k] = b.w[0], f.wy[k] = b.w[1], f.wz[k] = b.w[2];
+      f.radius[k] = b.start_radius;
+      growth[id] = {rf, (rf - b.start_radius) / growth_time};
+      flow.count_inserted(spec_.fine, f.mass[k]);
+      refined_.particle_units += mass_units(f.mass[k]);
+      ++refined_.particles;
+    }
+    ++refined_.parcels;
+  }
+  for (const auto& [r, m] : carried) refined_.carried_units += m.units;
+  refined_.momentum_residual = books.momentum_residual();
+  auto norm = [](const double* v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); };
+  refined_.angular_in = norm(books.angular_in);
+  refined_.angular_out = norm(books.angular_out);
+  refined_.kinetic_in = books.kinetic_in;
+  refined_.kinetic_out = books.kinetic_out;
+  refined_.fluctuation = books.fluctuation;
+  refined_.smallest_start = books.smallest_start;
+  refined_.growth_time = growth_time;
+  const auto [begin, end] = ranks_->keep_added(fine, f, first);
+  ParticleStore& own = fine.particles_to_edit();
+  for (std::size_t k = begin; k < end; ++k) {
+    const auto& [to, rate] = growth.at(own.id[k]);
+    fine.grow(k, to, rate);
+  }
+  if (end > begin) fine.apply_body_forces(begin, end);
+  if (ranks_->rank() == 0)
+    spdlog::info("{}: {} coarse parcel(s) ({:.6g} kg) lie in the region at the start: refined into {} fine particles "
+                 "({:.6g} kg, {:.3g} kg carried short of a whole particle), placed at {:.3g} of their radius and "
+                 "upward, growing to it over {:.4g} s ({} fine steps); kinetic energy {:.4g} J -> {:.4g} J, of "
+                 "which {:.4g} J about the parcels' motion",
+                 spec_.where, refined_.parcels, mass_kg(refined_.parcel_units), refined_.particles,
+                 mass_kg(refined_.particle_units), mass_kg(refined_.carried_units), refined_.smallest_start,
+                 growth_time, spec_.growth_steps, refined_.kinetic_in, refined_.kinetic_out, refined_.fluctuation);
 }
 
 void Coupling::exchange(double t, std::vector<std::unique_ptr<Subdomain>>& subdomains,
@@ -646,6 +769,30 @@ void Coupling::fields(CheckpointFields& f) {
     f("face" + std::to_string(face) + "_counted_ids", counted);
     if (load) counted_ids_[face] = std::unordered_set<std::uint64_t>(counted.begin(), counted.end());
   }
+  // the refinement at the start, for the summary (in a checkpoint only when it made something)
+  if (load ? f.reader().has(p + "refined_units") : refined_.parcels > 0) {
+    std::vector<MassUnits> ru;
+    std::vector<std::uint64_t> rc;
+    std::vector<double> rr;
+    if (!load) {
+      ru = {refined_.parcel_units, refined_.particle_units, refined_.carried_units};
+      rc = {refined_.parcels, refined_.particles};
+      rr = {refined_.momentum_residual, refined_.angular_in, refined_.angular_out, refined_.kinetic_in,
+            refined_.kinetic_out, refined_.fluctuation, refined_.smallest_start, refined_.growth_time};
+    }
+    mass_units_field(f, "refined_units", ru);
+    f("refined_counts", rc);
+    f("refined_reals", rr);
+    if (load) {
+      if (ru.size() != 3 || rc.size() != 2 || rr.size() != 8)
+        f.reader().fail(p + "refined_units", "does not hold the books of a refinement at the start");
+      refined_.parcel_units = ru[0], refined_.particle_units = ru[1], refined_.carried_units = ru[2];
+      refined_.parcels = rc[0], refined_.particles = rc[1];
+      refined_.momentum_residual = rr[0], refined_.angular_in = rr[1], refined_.angular_out = rr[2];
+      refined_.kinetic_in = rr[3], refined_.kinetic_out = rr[4], refined_.fluctuation = rr[5];
+      refined_.smallest_start = rr[6], refined_.growth_time = rr[7];
+    }
+  }
   std::string rng_text;
   if (!load) {
     std::ostringstream rng;
@@ -772,6 +919,25 @@ nlohmann::json Coupling::summary(const std::vector<std::unique_ptr<Subdomain>>& 
                                                 {"coarse_sink_parcels", outflow_.n_sink},
                                                 {"deficit_kg", outflow_.deficit()}}
                                : nlohmann::json(false)},
+          {"refined_at_start",
+           refined_.parcels > 0
+               ? nlohmann::json{{"parcels", refined_.parcels},
+                                {"parcels_kg", mass_kg(refined_.parcel_units)},
+                                {"particles", refined_.particles},
+                                {"particles_kg", mass_kg(refined_.particle_units)},
+                                {"carried_kg", mass_kg(refined_.carried_units)},
+                                {"mass_residual_units", static_cast<double>(refined_.parcel_units -
+                                                                           refined_.particle_units -
+                                                                           refined_.carried_units)},
+                                {"momentum_residual", refined_.momentum_residual},
+                                {"angular_momentum_in", refined_.angular_in},
+                                {"angular_momentum_out", refined_.angular_out},
+                                {"kinetic_in_J", refined_.kinetic_in},
+                                {"kinetic_out_J", refined_.kinetic_out},
+                                {"fluctuation_J", refined_.fluctuation},
+                                {"smallest_start_radius", refined_.smallest_start},
+                                {"growth_time_s", refined_.growth_time}}
+               : nlohmann::json(false)},
           {"stress_control", spec_.stress.enabled ? spec_.stress.params : nlohmann::json(false)},
           {"velocity_control", spec_.velocity.enabled ? spec_.velocity.params : nlohmann::json(false)}};
 }

@@ -38,6 +38,7 @@
 #pragma once
 
 #include "averaging/cell_grid.hpp"
+#include "coupling/conversion.hpp"
 #include "geometry/wall.hpp"
 #include "loader/plugin_registry.hpp"
 #include "flow/particle_flow.hpp"
@@ -96,6 +97,7 @@ struct CouplingSpec {
   int attempts = 1000;
   double grid_interval = 0;          ///< [s] between grid files; 0: none
   bool match_outflow = false;        ///< remove coarse parcels so the coarse outflow follows the fine one
+  int growth_steps = 2000;           ///< fine steps over which particles refined at the start grow to their size
   std::uint64_t seed = 1;
   // timing, resolved from the levels' sub-steps per macro step
   std::uint64_t control_macro = 1;   ///< macro steps per control interval
@@ -160,6 +162,28 @@ class Coupling {
   /// the balance file. `out` empty: no files. Collective on ranks.
   void start(std::vector<std::unique_ptr<Subdomain>>& subdomains, const std::vector<WallPrimitive>& walls,
              const std::filesystem::path& out);
+  /// What the refinement at the start made (refine_at_start): the coarse
+  /// parcels inside the region and their mass, the fine particles made and
+  /// theirs, the mass carried (short of a whole fine particle, per parcel
+  /// size), and the operation's books (conversion.hpp).
+  struct StartRefinement {
+    std::uint64_t parcels = 0, particles = 0;
+    MassUnits parcel_units = 0, particle_units = 0, carried_units = 0;
+    double momentum_residual = 0;  ///< [kg m/s] largest component, parcels (and carried) in minus particles out
+    double angular_in = 0, angular_out = 0;  ///< [kg m^2/s] magnitude of the sums about each parcel's centre
+    double kinetic_in = 0, kinetic_out = 0;  ///< [J]
+    double fluctuation = 0;        ///< [J] kinetic energy of the particles' velocities about their parcel's
+    double smallest_start = 1;     ///< smallest start radius over full radius
+    double growth_time = 0;        ///< [s] growth_steps fine steps
+  };
+  const StartRefinement& start_refinement() const { return refined_; }
+  /// On a fresh start, after start(): when the fine level holds no particle,
+  /// every coarse parcel whose centre lies in the region becomes fine
+  /// particles (refine_parcel) that grow to their size over growth_steps of
+  /// the fine level's steps, counted as inserted into the fine level's
+  /// books; the parcels stay, as the image of that material (docs/adaptive.md).
+  /// Collective on ranks.
+  void refine_at_start(std::vector<std::unique_ptr<Subdomain>>& subdomains, ParticleFlow& flow);
   /// One control interval at time t (all levels stand at t): steps 1-4 of
   /// the file comment. External forces of both levels must have been zeroed
   /// by the caller (several couplings add into the same level). Collective
@@ -205,6 +229,7 @@ class Coupling {
   // the removals return the ids removed, in store order.
   std::vector<std::uint64_t> remove_escaped(ParticleStore& fine, ParticleFlow& flow);
   void count_inflow(const ParticleStore& coarse);
+  void fit_in_region(const ConvertedBody& parcel, std::vector<ConvertedBody>& made) const;
   std::vector<std::uint64_t> match_outflow(ParticleStore& coarse, const Subdomain& level, ParticleFlow& flow);
   void transfer(double t, Subdomain& level, ParticleStore& fine, const std::vector<WallPrimitive>& walls,
                 ParticleFlow& flow);
@@ -230,6 +255,7 @@ class Coupling {
   double last_row_t_ = -1;
   Timing timing_;
   Outflow outflow_;
+  StartRefinement refined_;
   double fine_dmax_ = 0;              ///< largest fine diameter seen (forcing layer, insertion hash)
   std::unique_ptr<io::CsvSeries> balance_;
   std::unique_ptr<io::CellGridVtkSeries> vtk_fine_, vtk_coarse_;

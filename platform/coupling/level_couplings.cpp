@@ -19,6 +19,21 @@ void LevelCouplings::setup(RunContext& ctx) {
     for (std::size_t k : {c->spec().fine, c->spec().coarse})
       if (std::find(levels_.begin(), levels_.end(), k) == levels_.end()) levels_.push_back(k);
   }
+  if (ctx.restart) return;  // what the start refined is in the checkpoint
+  // Material in a fine region at the start is refined, coarser levels first:
+  // a coupling whose coarse level is the fine level of one not yet done waits
+  // for it, so that nested levels fill from the coarsest down.
+  std::vector<Coupling*> todo;
+  for (auto& c : couplings_) todo.push_back(c.get());
+  while (!todo.empty()) {
+    auto ready = std::find_if(todo.begin(), todo.end(), [&](const Coupling* c) {
+      return std::none_of(todo.begin(), todo.end(),
+                          [&](const Coupling* o) { return o != c && o->spec().fine == c->spec().coarse; });
+    });
+    if (ready == todo.end()) ready = todo.begin();  // a cycle (refused when the scenario is built): as listed
+    (*ready)->refine_at_start(ctx.subdomains, flow_);
+    todo.erase(ready);
+  }
 }
 
 void LevelCouplings::before_macro(RunContext& ctx, const MacroStep& step) {

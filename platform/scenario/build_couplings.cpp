@@ -359,30 +359,16 @@ void build_couplings(Build& b) {
         break;
       }
     }
-    // Material inside the region at the start, or poured into it: the fine
-    // level receives what crosses its inflow faces, never what is already
-    // inside, so unless the fine level starts with particles of its own for
-    // it, that material would never reach the fine level.
+    // Material poured into the region: the fine level receives what crosses
+    // its inflow faces, and what lies inside at the start is refined
+    // (Coupling::refine_at_start), but a coarse parcel poured inside it later
+    // would never reach the fine level.
     auto inside = [&](double x, double y, double z) {
       const double p[3] = {x, y, z};
       for (int a = 0; a < 3; ++a)
         if (!(p[a] > s.grid.lo[a] && p[a] < s.grid.hi[a])) return false;
       return true;
     };
-    if (fine.store().size() == 0 && b.ck.diags.size() == before) {  // one problem of the region at a time
-      const ParticleStore& cp = coarse.store();
-      std::size_t n = 0;
-      double kg = 0;
-      for (std::size_t q = 0; q < cp.size(); ++q)
-        if (inside(cp.x[q], cp.y[q], cp.z[q])) ++n, kg += cp.mass[q];
-      if (n > 0)
-        b.ck.add(base + "/region",
-                 std::to_string(n) + " parcel(s) of '" + names[s.coarse] + "' (" + fmt_num(kg) +
-                     " kg) lie inside the fine region at the start; the fine level '" + names[s.fine] +
-                     "' receives only what crosses its inflow faces, so their material would never reach it",
-                 "start the coarse level's particles outside the region, or give '" + names[s.fine] +
-                     "' particles of its own for that material (insert or initial_state)");
-    }
     for (std::size_t q = 0; q < sim.flow.pours.size(); ++q) {
       const Pour& p = sim.flow.pours[q];
       if (p.subdomain != s.coarse) continue;
@@ -428,6 +414,7 @@ void build_couplings(Build& b) {
     s.attempts = cj["insertion_attempts"].get<int>();
     s.grid_interval = cj["grid_interval"].get<double>();
     s.match_outflow = cj["match_outflow"].get<bool>();
+    s.growth_steps = cj["refine_growth_steps"].get<int>();
     s.fine_density = sim.materials[fine.material()].density;
     s.alpha_ratio = fine.coarse_grain() / coarse.coarse_grain();
     // one seed per coupling: the run's seed and the coupling's index mixed as the pours' seeds are

@@ -17,12 +17,16 @@
 // fine particles for 0.12 s, and again from the middle of the growth).
 #include "core/archive.hpp"
 #include "coupling/conversion.hpp"
+#include "coupling/coupling.hpp"
+#include "scheduler/simulation.hpp"
 #include "support/fixture.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <random>
+#include <unistd.h>
 
 namespace dt = domel::test;
 using domel::platform::CarriedMass;
@@ -170,4 +174,92 @@ TEST(Refinement, AColumnRefinedAtRestRegrowsWithoutBurstingAndComesToRestAsHighA
     ASSERT_EQ(a.z[k], b.z[k]) << k;
     ASSERT_EQ(a.vz[k], b.vz[k]) << k;
   }
+}
+
+TEST(Refinement, ParcelsInAFineRegionAtTheStartBecomeItsMaterialWithExactBooks) {
+  // A lattice of 2.8 mm parcels (alpha 2) 20 mm deep in a box 10 parcels
+  // wide; the coupling's fine region (alpha 1) holds its lower 10 mm. The
+  // fine level starts empty: each parcel whose centre lies in the region is
+  // refined into eight 1.4 mm particles that grow to their size over 2000
+  // fine steps (0.036 s, refine_growth_steps' default), counted into the
+  // fine level's books. Checked after 0.06 s: the count made (eight per
+  // parcel inside, counted here from the built scenario), the mass to the
+  // unit (the ratio is whole: what is carried is the masses' rounding to
+  // the unit, a few units a parcel), the fine books closed, every particle grown, and what
+  // left through the region's top face while the packing regrew less than
+  // a layer of the overshoot of a regrowing column (3 fine diameters:
+  // Refinement.AColumnRefinedAtRest...). Cost: about 3 s.
+  const double d = 0.0014, a = 1.02 * 2 * d, w = 10 * a;  // material diameter; parcels of 2 d on a lattice
+  json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
+  doc["gravity"] = {0, 0, -9.81};
+  json coarse = {{"name", "coarse"}, {"material", "m"}, {"coarse_grain", 2}, {"contact", dt::hertz_mindlin()},
+                 {"time_step", 3.6e-5}};
+  coarse["insert"] = {{{"model", "lattice"}, {"diameter", d}, {"spacing", 1.02},
+                       {"region", {{"box", {{"min", {0, 0, 0}}, {"max", {w, w, 0.02}}}}}}}};
+  json fine = {{"name", "fine"}, {"material", "m"}, {"coarse_grain", 1}, {"contact", dt::hertz_mindlin()},
+               {"time_step", 1.8e-5}};
+  doc["subdomains"] = {coarse, fine};
+  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}}, {"max", {w, w, 0.06}},
+                   {"open", {"zmax"}}}};
+  const double region_top = 0.01;
+  doc["couplings"] = {{{"name", "zone"},
+                       {"coarse", "coarse"},
+                       {"fine", "fine"},
+                       {"region", {{"min", {0, 0, 0}}, {"max", {w, w, region_top}}, {"cells", {2, 2, 1}}}},
+                       {"inflow_faces", {"+z"}}}};
+  doc["run"]["duration"] = 0.06;
+  auto sim = dt::build(doc);
+  const auto& parcels = sim->subdomains[0]->store();
+  std::size_t inside = 0;
+  domel::platform::MassUnits inside_units = 0;
+  for (std::size_t q = 0; q < parcels.size(); ++q)
+    if (parcels.z[q] <= region_top) ++inside, inside_units += domel::platform::mass_units(parcels.mass[q]);
+  ASSERT_GT(inside, 200u);
+  EXPECT_EQ(sim->subdomains[1]->store().size(), 0u);
+  domel::platform::RunOptions opt;
+  opt.progress = false;
+  opt.output_directory = std::filesystem::temp_directory_path() / ("domel_refine_start_" + std::to_string(getpid()));
+  sim->run(opt, dt::builtin_registry());
+  std::filesystem::remove_all(opt.output_directory);
+
+  const auto& r = sim->couplings.at(0)->start_refinement();
+  EXPECT_EQ(r.parcels, inside);
+  EXPECT_EQ(r.particles, 8 * inside);
+  EXPECT_EQ(r.parcel_units, inside_units);
+  EXPECT_EQ(r.particle_units + r.carried_units, r.parcel_units);  // exact, in units of 1e-18 kg
+  // what is carried is the rounding of nine masses to the unit, at most 4.5 units a parcel (the ratio is whole)
+  EXPECT_LE(std::abs(static_cast<double>(r.carried_units)), 4.5 * static_cast<double>(inside));
+  EXPECT_GT(r.smallest_start, 0.6);
+  const auto& f = sim->subdomains[1]->store();
+  EXPECT_EQ(sim->flow.residual(1, f), 0);
+  const double rf = d / 2;
+  double highest = 0, smallest = 1;
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    smallest = std::min(smallest, f.radius[k] / rf);
+    highest = std::max(highest, f.z[k] + f.radius[k]);
+  }
+  const auto st = sim->subdomains[1]->stats();
+  std::printf("[refined at start] %llu parcels -> %llu particles (start radius >= %.3f of theirs), carried %lld "
+              "units; at 0.06 s: %zu fine particles, smallest radius %.4f of theirs, highest top %.2f mm, largest "
+              "overlap %.2f %%, kinetic energy %.3g J; books of the operation: momentum residual %.2g kg m/s, "
+              "kinetic %.3g -> %.3g J\n",
+              static_cast<unsigned long long>(r.parcels), static_cast<unsigned long long>(r.particles),
+              r.smallest_start, static_cast<long long>(r.carried_units), f.size(), smallest, 1e3 * highest,
+              100 * st.max_overlap_ratio, st.kinetic_translational + st.kinetic_rotational, r.momentum_residual,
+              r.kinetic_in, r.kinetic_out);
+  // What left the fine level went out through the top face (the inflow face: a fine particle that crosses it
+  // is removed, docs/multilevel.md) while the regrowing packing overshot; the other faces are the box's walls.
+  // The overshoot of a regrowing column is below 3 fine diameters (Refinement.AColumnRefinedAtRest...): at most
+  // the particles of a 3-diameter layer at a solid fraction of 0.6 leave.
+  const auto& faces = sim->couplings.at(0)->faces();
+  for (int face = 0; face < 5; ++face) EXPECT_EQ(faces[face].n_removed, 0u) << face;
+  EXPECT_EQ(f.size() + faces[5].n_removed, r.particles + faces[5].n_inserted);
+  const double layer = 0.6 * w * w * 6 * rf / (4.0 / 3.0 * M_PI * rf * rf * rf);
+  std::printf("[refined at start] out through the top face: %llu (a 3-diameter layer holds %.0f), inserted "
+              "there: %llu\n",
+              static_cast<unsigned long long>(faces[5].n_removed), layer,
+              static_cast<unsigned long long>(faces[5].n_inserted));
+  EXPECT_LT(static_cast<double>(faces[5].n_removed), layer);
+  EXPECT_EQ(smallest, 1.0);  // all grown: the growth caps at the radius exactly
+  EXPECT_LT(highest, region_top + 2 * rf);  // what crosses the top face leaves at the next exchange
 }
