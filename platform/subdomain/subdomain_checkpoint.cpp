@@ -170,6 +170,10 @@ std::size_t Subdomain::load_state(const ArchiveReader& r, const std::string& p, 
                                          "; subdomain '" + name_ + "' now has " + std::to_string(coarse_grain_));
   if (st.skin != skin_) r.fail(p + "state/skin", "was written with another neighbour-list skin");
   nlist_.configure(skin_, pipeline_->history_stride());
+  // particles placed small by a refinement at the start (a coupling whose fine
+  // level started empty: Coupling::refine_at_start) carry the growth fields,
+  // which a restarted scenario only adds when it refines again: add them here
+  if (r.has(p + "particles/grow_to")) enable_growth();
   store_.load(r, p + "particles/");
   if (!st.ranked) st.owned = st.ghosts_end = store_.size();  // a part of one process: all its own, no ghosts
   const auto own = static_cast<std::size_t>(st.owned);

@@ -64,7 +64,8 @@ dp::RunResult run(const json& doc, const fs::path& out, int threads, std::uint64
 /// step k (checkpoints every `interval` s, and one at the stop) restarted
 /// from its checkpoint; every file the first wrote is byte-identical in the second.
 /// Returns the summary of the stopped run.
-json expect_restart_identical(json doc, const std::string& name, std::uint64_t k, double interval, int threads) {
+json expect_restart_identical(json doc, const std::string& name, std::uint64_t k, double interval, int threads,
+                              json* resumed_summary = nullptr) {
   doc["output"]["state"] = true;
   const fs::path plain = scratch(name + "_plain_" + std::to_string(threads));
   const fs::path resumed = scratch(name + "_resumed_" + std::to_string(threads));
@@ -104,6 +105,7 @@ json expect_restart_identical(json doc, const std::string& name, std::uint64_t k
   EXPECT_NE(std::find(listed.begin(), listed.end(), dp::kCheckpointFile), listed.end());
   // the books agree too
   EXPECT_EQ(a.summary.value("mass_balance", json()).dump(), b.summary.value("mass_balance", json()).dump());
+  if (resumed_summary) *resumed_summary = b.summary;
   fs::remove_all(plain);
   fs::remove_all(resumed);
   return first.summary;
@@ -152,6 +154,34 @@ json coupled_silo() {
   d["output"]["vtk_interval"] = 0.04;
   d["output"]["probe_interval"] = 0.004;
   return d;
+}
+
+json refined_region() {
+  // a lattice of 2.8 mm parcels (alpha 2) 20 mm deep whose lower 10 mm are a
+  // coupling's fine region (alpha 1), the fine level empty: the parcels there
+  // are refined at the start and grow over 2000 fine steps (0.036 s)
+  namespace dt = domel::test;
+  const double d = 0.0014, a = 1.02 * 2 * d, w = 10 * a;
+  json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
+  doc["gravity"] = {0, 0, -9.81};
+  json coarse = {{"name", "coarse"}, {"material", "m"}, {"coarse_grain", 2}, {"contact", dt::hertz_mindlin()},
+                 {"time_step", 3.6e-5}};
+  coarse["insert"] = {{{"model", "lattice"}, {"diameter", d}, {"spacing", 1.02},
+                       {"region", {{"box", {{"min", {0, 0, 0}}, {"max", {w, w, 0.02}}}}}}}};
+  json fine = {{"name", "fine"}, {"material", "m"}, {"coarse_grain", 1}, {"contact", dt::hertz_mindlin()},
+               {"time_step", 1.8e-5}};
+  doc["subdomains"] = {coarse, fine};
+  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}}, {"max", {w, w, 0.06}},
+                   {"open", {"zmax"}}}};
+  doc["couplings"] = {{{"name", "zone"},
+                       {"coarse", "coarse"},
+                       {"fine", "fine"},
+                       {"region", {{"min", {0, 0, 0}}, {"max", {w, w, 0.01}}, {"cells", {2, 2, 1}}}},
+                       {"inflow_faces", {"+z"}}}};
+  doc["run"]["duration"] = 0.03;
+  doc["output"]["vtk_interval"] = 0.01;
+  doc["output"]["probe_interval"] = 0.002;
+  return doc;
 }
 
 json water_bed(const std::string& backend) {
@@ -254,6 +284,21 @@ TEST(Checkpoint, CoupledSiloRestartedIsBitIdentical) {
     const json& c = stopped["couplings"]["zone1"];
     EXPECT_GT(c["transfers"].get<int>(), 0);
     EXPECT_GT(c["faces"]["-z"]["removed"].get<int>(), 0) << "the fine level discharges before the stop";
+  }
+}
+
+TEST(Checkpoint, ARegionRefinedAtTheStartRestartedMidGrowthIsBitIdentical) {
+  // stopped halfway through the growth of the particles refined at the start
+  // (docs/adaptive.md): the growth fields, the lists' growth and the
+  // refinement's books come back from the checkpoint, and the restart does
+  // not refine again. Cost: about 4 s.
+  for (int threads : {1, 2}) {
+    json resumed;
+    const json stopped = expect_restart_identical(refined_region(), "refined", 417, 0.01, threads, &resumed);
+    const json& r = stopped["couplings"]["zone"]["refined_at_start"];
+    ASSERT_TRUE(r.is_object());
+    EXPECT_EQ(r["particles"].get<int>(), 3200);
+    EXPECT_EQ(resumed["couplings"]["zone"]["refined_at_start"].dump(), r.dump());
   }
 }
 
