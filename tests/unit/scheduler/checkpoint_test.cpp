@@ -291,7 +291,7 @@ TEST(Checkpoint, ARegionRefinedAtTheStartRestartedMidGrowthIsBitIdentical) {
   // stopped halfway through the growth of the particles refined at the start
   // (docs/adaptive.md): the growth fields, the lists' growth and the
   // refinement's books come back from the checkpoint, and the restart does
-  // not refine again. Cost: about 4 s.
+  // not refine again. Cost: about 6 s.
   for (int threads : {1, 2}) {
     json resumed;
     const json stopped = expect_restart_identical(refined_region(), "refined", 417, 0.01, threads, &resumed);
