@@ -192,14 +192,14 @@ struct WallPrimitive {
     }
     const double tr = radius_hi - radius, ts = hi - lo;
     const double len2 = tr * tr + ts * ts;
-    const double len = std::sqrt(len2);
-    const double mr = -ts / len, ms = tr / len;  // inward unit normal of the segment
-    const double across = (rho - radius) * mr + (s - lo) * ms;  // signed distance from the segment's line
-    const bool solid = across < 0.0 && s >= lo && s <= hi;       // behind the mantle within its extent
+    // the side of the segment's line, positive on the axis side (unnormalised: only its sign is needed here)
+    const bool solid = (rho - radius) * -ts + (s - lo) * tr < 0.0 && s >= lo && s <= hi;  // behind the mantle
     double u = ((rho - radius) * tr + (s - lo) * ts) / len2;
     double dr, ds;  // unit direction from the closest point to the point, in (rho, s)
     if (u > 0.0 && u < 1.0) {
-      d = across;
+      const double len = std::sqrt(len2);
+      const double mr = -ts / len, ms = tr / len;  // inward unit normal of the segment
+      d = (rho - radius) * mr + (s - lo) * ms;     // signed distance from the segment
       dr = mr; ds = ms;
       if (d < 0.0 && !solid) {  // behind the line beyond the extent (under a flat funnel): the outer face
         d = -d;

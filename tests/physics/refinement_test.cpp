@@ -189,25 +189,9 @@ TEST(Refinement, ParcelsInAFineRegionAtTheStartBecomeItsMaterialWithExactBooks) 
   // left through the region's top face while the packing regrew less than
   // a layer of the overshoot of a regrowing column (3 fine diameters:
   // Refinement.AColumnRefinedAtRest...). Cost: about 3 s.
-  const double d = 0.0014, a = 1.02 * 2 * d, w = 10 * a;  // material diameter; parcels of 2 d on a lattice
-  json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
-  doc["gravity"] = {0, 0, -9.81};
-  json coarse = {{"name", "coarse"}, {"material", "m"}, {"coarse_grain", 2}, {"contact", dt::hertz_mindlin()},
-                 {"time_step", 3.6e-5}};
-  coarse["insert"] = {{{"model", "lattice"}, {"diameter", d}, {"spacing", 1.02},
-                       {"region", {{"box", {{"min", {0, 0, 0}}, {"max", {w, w, 0.02}}}}}}}};
-  json fine = {{"name", "fine"}, {"material", "m"}, {"coarse_grain", 1}, {"contact", dt::hertz_mindlin()},
-               {"time_step", 1.8e-5}};
-  doc["subdomains"] = {coarse, fine};
-  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}}, {"max", {w, w, 0.06}},
-                   {"open", {"zmax"}}}};
+  const double d = 0.0014, w = 10 * 1.02 * 2 * d;  // material diameter; the box's width (dt::refined_region)
   const double region_top = 0.01;
-  doc["couplings"] = {{{"name", "zone"},
-                       {"coarse", "coarse"},
-                       {"fine", "fine"},
-                       {"region", {{"min", {0, 0, 0}}, {"max", {w, w, region_top}}, {"cells", {2, 2, 1}}}},
-                       {"inflow_faces", {"+z"}}}};
-  doc["run"]["duration"] = 0.06;
+  const json doc = dt::refined_region(0.06);
   auto sim = dt::build(doc);
   const auto& parcels = sim->subdomains[0]->store();
   std::size_t inside = 0;

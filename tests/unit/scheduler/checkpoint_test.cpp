@@ -157,28 +157,8 @@ json coupled_silo() {
 }
 
 json refined_region() {
-  // a lattice of 2.8 mm parcels (alpha 2) 20 mm deep whose lower 10 mm are a
-  // coupling's fine region (alpha 1), the fine level empty: the parcels there
-  // are refined at the start and grow over 2000 fine steps (0.036 s)
-  namespace dt = domel::test;
-  const double d = 0.0014, a = 1.02 * 2 * d, w = 10 * a;
-  json doc = dt::scenario(dt::hertz_mindlin(), 1.8e-5, 0.5, 0.5);
-  doc["gravity"] = {0, 0, -9.81};
-  json coarse = {{"name", "coarse"}, {"material", "m"}, {"coarse_grain", 2}, {"contact", dt::hertz_mindlin()},
-                 {"time_step", 3.6e-5}};
-  coarse["insert"] = {{{"model", "lattice"}, {"diameter", d}, {"spacing", 1.02},
-                       {"region", {{"box", {{"min", {0, 0, 0}}, {"max", {w, w, 0.02}}}}}}}};
-  json fine = {{"name", "fine"}, {"material", "m"}, {"coarse_grain", 1}, {"contact", dt::hertz_mindlin()},
-               {"time_step", 1.8e-5}};
-  doc["subdomains"] = {coarse, fine};
-  doc["walls"] = {{{"name", "box"}, {"type", "box"}, {"material", "m"}, {"min", {0, 0, 0}}, {"max", {w, w, 0.06}},
-                   {"open", {"zmax"}}}};
-  doc["couplings"] = {{{"name", "zone"},
-                       {"coarse", "coarse"},
-                       {"fine", "fine"},
-                       {"region", {{"min", {0, 0, 0}}, {"max", {w, w, 0.01}}, {"cells", {2, 2, 1}}}},
-                       {"inflow_faces", {"+z"}}}};
-  doc["run"]["duration"] = 0.03;
+  // the parcels in the fine region are refined at the start and grow over 2000 fine steps (0.036 s)
+  json doc = domel::test::refined_region(0.03);
   doc["output"]["vtk_interval"] = 0.01;
   doc["output"]["probe_interval"] = 0.002;
   return doc;
